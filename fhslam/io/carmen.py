@@ -1,0 +1,326 @@
+"""CARMEN text logs: one message per line, ``NAME [contents] ipc_timestamp host logger_timestamp``.
+
+Read: ``FLASER`` (old format) and ``ROBOTLASER1`` laser messages become the scans of a
+:class:`~fhslam.io.log.Log`; ``#`` comments, blank lines and every other message (``ODOM``,
+``PARAM``, ``SYNC``, ``TRUEPOS``, ...) are skipped, since the laser messages carry the
+odometry pose themselves.
+
+Write: one ``ODOM`` and one ``FLASER`` line per scan, every number as Python's shortest
+round-trip ``repr``, so reading the file back gives exactly the same floats. Both pose
+triples of a written ``FLASER`` line are the *odometry*; ground truth never goes into a log.
+
+Formats (CARMEN logger documentation; see ``data/SOURCES.md``)::
+
+    ODOM x y theta tv rv accel ipc_timestamp hostname logger_timestamp
+    FLASER n r_1 ... r_n x y theta odom_x odom_y odom_theta ipc_timestamp hostname logger_ts
+    ROBOTLASER1 laser_type start_angle field_of_view angular_resolution maximum_range
+        accuracy remission_mode n r_1 ... r_n num_remissions [remissions]
+        laser_x laser_y laser_theta robot_x robot_y robot_theta tv rv
+        forward_safety_dist side_safety_dist turn_axis ipc_timestamp hostname logger_ts
+"""
+
+from __future__ import annotations
+
+import errno
+from os import PathLike
+from pathlib import Path
+
+import numpy as np
+from numpy.typing import NDArray
+
+from fhslam.geometry import relative, wrap_angle
+from fhslam.io.log import Log
+
+HOSTNAME = "fhslam"
+DEFAULT_MAX_RANGE = 8.0
+
+
+class CarmenFormatError(ValueError):
+    """A malformed CARMEN log. The message reads ``"{path}:{lineno}: {what is wrong}"``."""
+
+
+def flaser_angles(n: int) -> NDArray[np.float64]:
+    """Bearings of an old-format ``FLASER`` scan of ``n`` beams: ``linspace(-pi/2, pi/2, n)``.
+
+    The message carries no angles; the convention (also used by the ``carmen_to_rosbag``
+    converter of the reference datasets) is a 180 degree scan from the right (-90 degrees) to
+    the left (+90 degrees), both ends included: an increment of pi/(n-1), i.e. exactly 1 degree
+    for 181 beams and 0.5 degree for 361. For 180-beam logs this gives pi/179 (about 1.006
+    degrees), not 1 degree.
+    """
+    return np.linspace(-np.pi / 2, np.pi / 2, n)
+
+
+# ----------------------------------------------------------------------------------- writing
+
+
+def _fmt(values: NDArray | list[float]) -> str:
+    """Space-separated shortest round-trip reprs of floats."""
+    return " ".join(repr(float(v)) for v in np.asarray(values, dtype=float).ravel())
+
+
+def write_carmen(log: Log, path: str | PathLike[str]) -> None:
+    """Write ``log`` as a CARMEN text log: a ``#`` header, then ``ODOM`` + laser line per scan.
+
+    Scans whose bearings follow :func:`flaser_angles` are written as old-format ``FLASER``;
+    any other evenly spaced bearings as ``ROBOTLASER1`` (which records start angle and
+    resolution). The poses written are ``log.odometry``; ``log.truth`` is not written (use
+    :func:`fhslam.io.write_trajectory` for it). ``tv``/``rv`` in ``ODOM`` are finite
+    differences of the odometry; ``accel`` is 0.
+
+    Parameters
+    ----------
+    log : Log
+    path : str or path-like
+        Output file, overwritten.
+
+    Raises
+    ------
+    ValueError
+        If the bearings are not evenly spaced (no CARMEN message can describe them).
+    """
+    n = log.n_beams
+    angles = log.angles
+    use_flaser = n >= 2 and np.allclose(angles, flaser_angles(n), rtol=0, atol=1e-12)
+    if not use_flaser:
+        res = (angles[-1] - angles[0]) / (n - 1) if n > 1 else 0.0
+        if not np.allclose(angles, angles[0] + np.arange(n) * res, rtol=0, atol=1e-9):
+            raise ValueError(
+                f"write_carmen: log {log.name!r} has unevenly spaced beam angles, which "
+                "neither FLASER nor ROBOTLASER1 can describe"
+            )
+
+    odom = log.odometry
+    dt = np.diff(log.timestamps)
+    step = relative(odom[:-1], odom[1:])
+    ok = dt > 0
+    tv = np.zeros(len(log))
+    rv = np.zeros(len(log))
+    tv[1:][ok] = np.sign(step[ok, 0]) * np.hypot(step[ok, 0], step[ok, 1]) / dt[ok]
+    rv[1:][ok] = wrap_angle(step[ok, 2]) / dt[ok]
+
+    laser = "FLASER" if use_flaser else "ROBOTLASER1"
+    header = [
+        f"# CARMEN log written by fhslam: {log.name}, {len(log)} scans of {n} beams, "
+        f"max range {log.max_range!r} m",
+        "# ODOM x y theta tv rv accel ipc_timestamp ipc_hostname logger_timestamp",
+        "# FLASER num_readings [range_readings] x y theta odom_x odom_y odom_theta "
+        "ipc_timestamp ipc_hostname logger_timestamp",
+        f"# {laser} poses are odometry; no ground truth is stored in this file",
+    ]
+    with Path(path).open("w", encoding="utf-8") as f:
+        f.write("\n".join(header) + "\n")
+        for k in range(len(log)):
+            ts = repr(float(log.timestamps[k]))
+            tail = f"{ts} {HOSTNAME} {ts}"
+            pose = _fmt(odom[k])
+            f.write(f"ODOM {pose} {_fmt([tv[k], rv[k], 0.0])} {tail}\n")
+            ranges = _fmt(log.ranges[k])
+            if use_flaser:
+                f.write(f"FLASER {n} {ranges} {pose} {pose} {tail}\n")
+            else:
+                fov, res = angles[-1] - angles[0], (angles[-1] - angles[0]) / (n - 1)
+                head = _fmt([angles[0], fov, res, log.max_range, 0.01])
+                f.write(
+                    f"ROBOTLASER1 0 {head} 0 {n} {ranges} 0 {pose} {pose} "
+                    f"{_fmt([tv[k], rv[k], 0.0, 0.0, 0.0])} {tail}\n"
+                )
+
+
+# ----------------------------------------------------------------------------------- reading
+
+
+def _floats(tokens: list[str], what: str, where: str) -> NDArray[np.float64]:
+    """Parse tokens as floats; a bad token raises :class:`CarmenFormatError` naming it."""
+    try:
+        return np.array(tokens, dtype=float)
+    except ValueError:
+        for i, tok in enumerate(tokens):
+            try:
+                float(tok)
+            except ValueError:
+                raise CarmenFormatError(
+                    f"{where}: non-numeric {what} {tok!r} (item {i + 1} of {len(tokens)})"
+                ) from None
+        raise  # pragma: no cover (numpy refused a list Python accepts)
+
+
+def _count(token: str, what: str, where: str) -> int:
+    """Parse a non-negative integer count field."""
+    try:
+        value = int(token)
+    except ValueError:
+        raise CarmenFormatError(f"{where}: {what} must be an integer, got {token!r}") from None
+    if value < 0:
+        raise CarmenFormatError(f"{where}: {what} must be >= 0, got {value}")
+    return value
+
+
+def _is_number(token: str) -> bool:
+    try:
+        float(token)
+    except ValueError:
+        return False
+    return True
+
+
+def _check_finite(values: NDArray[np.float64], what: str, where: str) -> None:
+    if not np.all(np.isfinite(values)):
+        raise CarmenFormatError(f"{where}: non-finite {what} {values.tolist()}")
+
+
+def _parse_flaser(fields: list[str], where: str) -> tuple[float, NDArray, NDArray, None]:
+    """``FLASER n r_1..r_n x y theta odom_x odom_y odom_theta ipc_ts host logger_ts``."""
+    if len(fields) < 2:
+        raise CarmenFormatError(f"{where}: truncated FLASER line (no num_readings)")
+    n = _count(fields[1], "FLASER num_readings", where)
+    expected = n + 11
+    if len(fields) != expected:
+        # A complete line ends with "... ipc_timestamp hostname logger_timestamp".
+        complete = len(fields) >= 11 and not _is_number(fields[-2])
+        if complete:
+            raise CarmenFormatError(
+                f"{where}: wrong reading count: FLASER num_readings is {n} but the line "
+                f"holds {len(fields) - 11} readings"
+            )
+        raise CarmenFormatError(
+            f"{where}: truncated FLASER line: num_readings {n} needs {expected} fields, "
+            f"found {len(fields)}"
+        )
+    ranges = _floats(fields[2 : 2 + n], "range reading", where)
+    poses = _floats(fields[2 + n : 8 + n], "pose value", where)
+    _check_finite(poses, "pose", where)
+    stamp = _floats([fields[8 + n]], "ipc_timestamp", where)
+    _check_finite(stamp, "ipc_timestamp", where)
+    return float(stamp[0]), ranges, poses[3:6], None
+
+
+def _parse_robotlaser1(
+    fields: list[str], where: str
+) -> tuple[float, NDArray, NDArray, NDArray[np.float64]]:
+    """``ROBOTLASER1`` (see the module docstring); returns the robot pose as odometry.
+
+    The remission block ``num_remissions [remissions]`` is optional (older CARMEN versions
+    write the message without it).
+    """
+    if len(fields) < 9:
+        raise CarmenFormatError(f"{where}: truncated ROBOTLASER1 line ({len(fields)} fields)")
+    head = _floats(fields[2:7], "ROBOTLASER1 header value", where)
+    _check_finite(head, "ROBOTLASER1 start_angle/fov/resolution/max_range/accuracy", where)
+    start, _fov, res, max_range, _acc = head
+    n = _count(fields[8], "ROBOTLASER1 num_readings", where)
+    if len(fields) == 23 + n:  # no remission block
+        tail = fields[9 + n :]
+    else:
+        if len(fields) < 10 + n:
+            raise CarmenFormatError(
+                f"{where}: truncated ROBOTLASER1 line: num_readings {n} needs at least "
+                f"{23 + n} fields, found {len(fields)}"
+            )
+        m = _count(fields[9 + n], "ROBOTLASER1 num_remissions", where)
+        if len(fields) != 24 + n + m:
+            raise CarmenFormatError(
+                f"{where}: ROBOTLASER1 with {n} readings and {m} remissions needs "
+                f"{24 + n + m} fields, found {len(fields)} (truncated line or wrong count)"
+            )
+        tail = fields[10 + n + m :]
+    ranges = _floats(fields[9 : 9 + n], "range reading", where)
+    poses = _floats(tail[0:6], "pose value", where)
+    _check_finite(poses, "pose", where)
+    stamp = _floats([tail[11]], "ipc_timestamp", where)
+    _check_finite(stamp, "ipc_timestamp", where)
+    return float(stamp[0]), ranges, poses[3:6], np.array([start, res, max_range])
+
+
+_PARSERS = {"FLASER": _parse_flaser, "ROBOTLASER1": _parse_robotlaser1}
+
+
+def read_carmen(path: str | PathLike[str], max_range: float | None = None) -> Log:
+    """Read the laser scans and their odometry from a CARMEN text log.
+
+    Parameters
+    ----------
+    path : str or path-like
+        The ``.clf``/``.log`` file.
+    max_range : float, optional
+        The laser's maximum range in metres (readings at or beyond it mean "no return").
+        Default: for ``ROBOTLASER1`` its ``maximum_range`` field; for ``FLASER`` (which does
+        not record it) ``max(8.0, largest reading in the file)``, so the "no return" code of
+        a log (e.g. 81.91 m in mit-csail) becomes the maximum range.
+
+    Returns
+    -------
+    Log
+        ``name`` is the file's stem; ``timestamps`` the ``ipc_timestamp`` of each scan;
+        ``odometry`` the ``odom_x odom_y odom_theta`` triple of ``FLASER`` (the
+        ``robot_pose`` of ``ROBOTLASER1``); ``angles`` :func:`flaser_angles` for ``FLASER``,
+        ``start_angle + k * angular_resolution`` for ``ROBOTLASER1``. No truth.
+
+    Raises
+    ------
+    FileNotFoundError
+        If ``path`` does not exist.
+    CarmenFormatError
+        ``"{path}:{lineno}: ..."`` for a malformed laser line (truncated, non-numeric field,
+        wrong reading count, non-finite pose), a beam count differing from the first scan's,
+        or a file with no laser messages or with both FLASER and ROBOTLASER1.
+    """
+    path = Path(path)
+    if not path.is_file():
+        raise FileNotFoundError(errno.ENOENT, "CARMEN log not found", str(path))
+    stamps: list[float] = []
+    ranges: list[NDArray] = []
+    odometry: list[NDArray] = []
+    first: tuple[str, int, int, NDArray | None] | None = None  # kind, lineno, n, geometry
+    try:
+        with path.open(encoding="utf-8") as f:
+            for lineno, line in enumerate(f, start=1):
+                fields = line.split()
+                if not fields or fields[0].startswith("#") or fields[0] not in _PARSERS:
+                    continue
+                kind, where = fields[0], f"{path}:{lineno}"
+                stamp, r, odom, geom = _PARSERS[kind](fields, where)
+                if first is None:
+                    first = (kind, lineno, len(r), geom)
+                    if len(r) == 0:
+                        raise CarmenFormatError(f"{where}: {kind} scan has no readings")
+                elif kind != first[0]:
+                    raise CarmenFormatError(
+                        f"{where}: {kind} after {first[0]} messages (line {first[1]}); logs "
+                        "mixing both laser messages are not supported"
+                    )
+                elif len(r) != first[2]:
+                    raise CarmenFormatError(
+                        f"{where}: {kind} has {len(r)} readings but the first scan (line "
+                        f"{first[1]}) has {first[2]}; varying beam counts are not supported"
+                    )
+                elif geom is not None and not np.allclose(geom[:2], first[3][:2]):
+                    raise CarmenFormatError(
+                        f"{where}: ROBOTLASER1 start_angle/angular_resolution {geom[:2]} differ"
+                        f" from the first scan's {first[3][:2]} (line {first[1]})"
+                    )
+                stamps.append(stamp)
+                ranges.append(r)
+                odometry.append(odom)
+    except UnicodeDecodeError as e:
+        raise CarmenFormatError(f"{path}: not a CARMEN text log ({e.reason})") from None
+    if first is None:
+        raise CarmenFormatError(f"{path}: no FLASER or ROBOTLASER1 laser messages found")
+
+    kind, _, n, geom = first
+    r = np.vstack(ranges)
+    if kind == "FLASER":
+        angles = flaser_angles(n)
+        finite = r[np.isfinite(r)]
+        inferred = max(DEFAULT_MAX_RANGE, float(finite.max())) if finite.size else DEFAULT_MAX_RANGE
+    else:
+        angles = geom[0] + np.arange(n) * geom[1]
+        inferred = float(geom[2])
+    return Log(
+        name=path.stem,
+        timestamps=np.array(stamps),
+        ranges=r,
+        angles=angles,
+        odometry=np.vstack(odometry),
+        max_range=inferred if max_range is None else float(max_range),
+    )

@@ -1,0 +1,106 @@
+"""`Log`: a sequence of laser scans with odometry, the one input format of the SLAM loops.
+
+Both the simulator (:func:`fhslam.sim.simulate`) and the file readers
+(:func:`fhslam.io.read_carmen`, ...) produce a :class:`Log`, so everything downstream works
+the same on simulated and real data.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
+import numpy as np
+from numpy.typing import NDArray
+
+if TYPE_CHECKING:  # io must not depend on sim at run time
+    from fhslam.sim.world import World
+
+
+@dataclass(eq=False)
+class Log:
+    """Laser scans with the odometry pose at each scan, and optionally the ground truth.
+
+    Attributes
+    ----------
+    name : str
+        A label, e.g. the world name or the log file's stem.
+    timestamps : ndarray, shape (T,)
+        Time of each scan in seconds (CARMEN: the ``ipc_timestamp``).
+    ranges : ndarray, shape (T, B)
+        Measured range of every beam, metres. A beam with no return reads ``max_range``
+        (or more, in real logs); such beams are invalid and are dropped before extraction.
+    angles : ndarray, shape (B,)
+        Bearing of each beam in the laser frame, radians, counter-clockwise from straight
+        ahead (the same for every scan).
+    odometry : ndarray, shape (T, 3)
+        Odometry pose ``(x, y, theta)`` of the robot at each scan, in the odometry frame.
+    max_range : float
+        Largest range the laser reports, metres; readings ``>= max_range`` mean "no return".
+    truth : ndarray, shape (T, 3), or None
+        Ground-truth pose at each scan (simulated logs only).
+    hits : ndarray of int, shape (T, B), or None
+        Index of the wall of ``world`` hit by each beam, -1 for no return (simulated only).
+    world : World or None
+        The world the log was simulated in.
+    """
+
+    name: str
+    timestamps: NDArray[np.float64]
+    ranges: NDArray[np.float64]
+    angles: NDArray[np.float64]
+    odometry: NDArray[np.float64]
+    max_range: float
+    truth: NDArray[np.float64] | None = None
+    hits: NDArray[np.intp] | None = None
+    world: World | None = None
+
+    def __post_init__(self) -> None:
+        self.timestamps = np.asarray(self.timestamps, dtype=float)
+        self.ranges = np.asarray(self.ranges, dtype=float)
+        self.angles = np.asarray(self.angles, dtype=float)
+        self.odometry = np.asarray(self.odometry, dtype=float)
+        self.max_range = float(self.max_range)
+        t = len(self.timestamps)
+        if self.timestamps.ndim != 1:
+            raise ValueError(f"Log.timestamps must have shape (T,), got {self.timestamps.shape}")
+        if self.angles.ndim != 1:
+            raise ValueError(f"Log.angles must have shape (B,), got {self.angles.shape}")
+        b = len(self.angles)
+        if self.ranges.shape != (t, b):
+            raise ValueError(
+                f"Log.ranges must have shape (T, B) = ({t}, {b}), got {self.ranges.shape}"
+            )
+        if self.odometry.shape != (t, 3):
+            raise ValueError(f"Log.odometry must have shape ({t}, 3), got {self.odometry.shape}")
+        if not self.max_range > 0:
+            raise ValueError(f"Log.max_range must be positive, got {self.max_range}")
+        if self.truth is not None:
+            self.truth = np.asarray(self.truth, dtype=float)
+            if self.truth.shape != (t, 3):
+                raise ValueError(f"Log.truth must have shape ({t}, 3), got {self.truth.shape}")
+        if self.hits is not None:
+            self.hits = np.asarray(self.hits, dtype=np.intp)
+            if self.hits.shape != (t, b):
+                raise ValueError(f"Log.hits must have shape ({t}, {b}), got {self.hits.shape}")
+
+    def __len__(self) -> int:
+        """Number of scans T."""
+        return len(self.timestamps)
+
+    @property
+    def n_beams(self) -> int:
+        """Number of beams per scan B."""
+        return len(self.angles)
+
+    def scan(self, k: int) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """Scan ``k`` as ``(ranges (B,), angles (B,))`` in the laser frame."""
+        return self.ranges[k], self.angles
+
+    def __repr__(self) -> str:
+        duration = self.timestamps[-1] - self.timestamps[0] if len(self) else 0.0
+        extras = [s for s, v in (("truth", self.truth), ("world", self.world)) if v is not None]
+        return (
+            f"Log({self.name!r}: {len(self)} scans x {self.n_beams} beams, {duration:.1f} s, "
+            f"max_range={self.max_range:g} m{', with ' + ' and '.join(extras) if extras else ''})"
+        )

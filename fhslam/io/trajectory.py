@@ -1,0 +1,116 @@
+"""Trajectory text files: one pose per line, ``timestamp x y theta``, ``#`` comments allowed.
+
+Used for estimated trajectories (``fhslam slam --trajectory``) and for simulated ground truth.
+Numbers are written with Python's shortest round-trip ``repr``, so a file reads back exactly.
+"""
+
+from __future__ import annotations
+
+import errno
+from collections.abc import Iterable
+from os import PathLike
+from pathlib import Path
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+
+class TrajectoryFormatError(ValueError):
+    """A malformed trajectory file. The message reads ``"{path}:{lineno}: {what is wrong}"``."""
+
+
+def write_trajectory(
+    path: str | PathLike[str],
+    timestamps: ArrayLike,
+    poses: ArrayLike,
+    header: str | Iterable[str] | None = None,
+) -> None:
+    """Write poses as ``timestamp x y theta`` lines.
+
+    Parameters
+    ----------
+    path : str or path-like
+        Output file, overwritten.
+    timestamps : array-like, shape (T,)
+        Seconds, e.g. the scans' own timestamps.
+    poses : array-like, shape (T, 3)
+        ``(x, y, theta)`` in metres and radians.
+    header : str or iterable of str, optional
+        Comment lines written first, each prefixed with ``"# "`` (a multi-line string is
+        split at newlines).
+    """
+    t = np.asarray(timestamps, dtype=float)
+    p = np.asarray(poses, dtype=float)
+    if t.ndim != 1 or len(t) == 0:
+        raise ValueError(f"timestamps must have shape (T,) with T >= 1, got {t.shape}")
+    if p.shape != (len(t), 3):
+        raise ValueError(f"poses must have shape ({len(t)}, 3) to match timestamps, got {p.shape}")
+    if not (np.all(np.isfinite(t)) and np.all(np.isfinite(p))):
+        raise ValueError("timestamps and poses must be finite")
+    if header is None:
+        comments: list[str] = []
+    elif isinstance(header, str):
+        comments = header.splitlines()
+    else:
+        comments = [c for h in header for c in str(h).splitlines()]
+    rows = np.column_stack([t, p]).tolist()
+    with Path(path).open("w", encoding="utf-8") as f:
+        for c in comments:
+            f.write(f"# {c}\n")
+        for row in rows:
+            f.write(" ".join(repr(v) for v in row) + "\n")
+
+
+def read_trajectory(path: str | PathLike[str]) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """Read a ``timestamp x y theta`` file.
+
+    Returns
+    -------
+    timestamps : ndarray, shape (T,)
+    poses : ndarray, shape (T, 3)
+
+    Raises
+    ------
+    FileNotFoundError
+        If ``path`` does not exist.
+    TrajectoryFormatError
+        ``"{path}:{lineno}: ..."`` for a line without exactly 4 fields, a non-numeric or
+        non-finite value, or ``"{path}: ..."`` for a file without poses.
+    """
+    path = Path(path)
+    if not path.is_file():
+        raise FileNotFoundError(errno.ENOENT, "trajectory file not found", str(path))
+    rows: list[list[float]] = []
+    try:
+        with path.open(encoding="utf-8") as f:
+            for lineno, line in enumerate(f, start=1):
+                fields = line.split()
+                if not fields or fields[0].startswith("#"):
+                    continue
+                where = f"{path}:{lineno}"
+                if len(fields) != 4:
+                    raise TrajectoryFormatError(
+                        f"{where}: expected 4 fields 'timestamp x y theta', found {len(fields)}"
+                    )
+                try:
+                    row = [float(v) for v in fields]
+                except ValueError:
+                    bad = next(v for v in fields if not _is_number(v))
+                    raise TrajectoryFormatError(f"{where}: non-numeric value {bad!r}") from None
+                if not all(np.isfinite(row)):
+                    raise TrajectoryFormatError(f"{where}: non-finite value in {fields}")
+                rows.append(row)
+    except UnicodeDecodeError as e:
+        raise TrajectoryFormatError(f"{path}: not a text file ({e.reason})") from None
+    if not rows:
+        raise TrajectoryFormatError(f"{path}: no poses found")
+    a = np.array(rows)
+    return a[:, 0], a[:, 1:]
+
+
+def _is_number(token: str) -> bool:
+    try:
+        float(token)
+    except ValueError:
+        return False
+    return True

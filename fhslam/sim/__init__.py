@@ -1,0 +1,33 @@
+"""Simulation: polygonal worlds, a ray-casting laser, drifting odometry, and `simulate()`."""
+
+from fhslam.sim.laser import LaserParams, add_range_noise, beam_angles, cast_rays
+from fhslam.sim.odometry import OdometryNoise, odometry_from_truth
+from fhslam.sim.simulate import MotionParams, follow_route, simulate
+from fhslam.sim.world import (
+    World,
+    WorldFormatError,
+    load_world,
+    paper_world,
+    random_world,
+    route_clearance,
+    segment_distances,
+)
+
+__all__ = [
+    "LaserParams",
+    "MotionParams",
+    "OdometryNoise",
+    "World",
+    "WorldFormatError",
+    "add_range_noise",
+    "beam_angles",
+    "cast_rays",
+    "follow_route",
+    "load_world",
+    "odometry_from_truth",
+    "paper_world",
+    "random_world",
+    "route_clearance",
+    "segment_distances",
+    "simulate",
+]

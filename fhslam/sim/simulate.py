@@ -1,0 +1,177 @@
+"""Simulate a robot driving a world's route: true poses, laser scans and drifting odometry.
+
+Stands in for the paper's SRIsim simulator (Pioneer II with a SICK LMS200, "Simulation
+result"). The output is an ordinary :class:`~fhslam.io.log.Log`; the ground truth rides along
+in ``Log.truth`` and is never written into the CARMEN log itself.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+from fhslam.geometry import wrap_angle
+from fhslam.io.log import Log
+from fhslam.sim.laser import LaserParams, add_range_noise, beam_angles, cast_rays
+from fhslam.sim.odometry import OdometryNoise, odometry_from_truth
+from fhslam.sim.world import World
+
+
+@dataclass(frozen=True)
+class MotionParams:
+    """How the simulated robot drives and how often it scans.
+
+    The controller steers toward the next waypoint: turn rate ``turn_gain * heading_error``
+    (limited to ``max_turn_rate``), forward speed ``speed`` at zero heading error falling
+    linearly to 0 at ``drive_angle_deg``, so sharp corners are turned on the spot and the
+    path stays close to the route polyline.
+
+    Attributes
+    ----------
+    speed : float
+        Cruising speed, m/s.
+    max_turn_rate : float
+        Largest turn rate, rad/s.
+    turn_gain : float
+        Proportional gain from heading error (rad) to turn rate (rad/s), 1/s.
+    drive_angle_deg : float
+        Heading error, degrees, at and beyond which the robot only turns.
+    scan_period : float
+        Time between scans, s (0.2 s: a 5 Hz laser).
+    waypoint_tolerance : float
+        A waypoint counts as reached within this distance, metres.
+    substeps : int
+        Integration steps of the unicycle model per scan period.
+    """
+
+    speed: float = 0.4
+    max_turn_rate: float = 0.6
+    turn_gain: float = 2.0
+    drive_angle_deg: float = 30.0
+    scan_period: float = 0.2
+    waypoint_tolerance: float = 0.1
+    substeps: int = 10
+
+    def __post_init__(self) -> None:
+        for name in ("speed", "max_turn_rate", "turn_gain", "drive_angle_deg", "scan_period"):
+            if not getattr(self, name) > 0:
+                raise ValueError(f"MotionParams.{name} must be positive, got {getattr(self, name)}")
+        if not self.waypoint_tolerance > 0:
+            raise ValueError(
+                f"MotionParams.waypoint_tolerance must be positive, got {self.waypoint_tolerance}"
+            )
+        if int(self.substeps) != self.substeps or self.substeps < 1:
+            raise ValueError(f"MotionParams.substeps must be an integer >= 1, got {self.substeps}")
+
+
+def follow_route(
+    world: World, motion: MotionParams | None = None, max_scans: int | None = None
+) -> NDArray[np.float64]:
+    """True poses at the scan times while driving ``world.route`` from ``world.start``.
+
+    Deterministic (no noise): a unicycle integrated with the midpoint rule, steered by the
+    controller described in :class:`MotionParams`. The run ends at the first scan after the
+    last waypoint is reached, or after ``max_scans`` scans.
+
+    Returns
+    -------
+    ndarray, shape (T, 3)
+        Pose ``(x, y, theta)`` at scan times ``0, period, 2 period, ...``.
+    """
+    m = MotionParams() if motion is None else motion
+    route = world.route
+    pose = world.start.astype(float).copy()
+    tol = m.waypoint_tolerance
+    target = 1 if np.hypot(*(route[0] - pose[:2])) <= tol else 0
+    dt = m.scan_period / m.substeps
+    drive_angle = np.radians(m.drive_angle_deg)
+    # A generous bound on the scans needed: driving time plus half a turn per waypoint, x3.
+    expected = world.route_length / m.speed + len(route) * np.pi / m.max_turn_rate
+    limit = int(3 * expected / m.scan_period) + 100 if max_scans is None else int(max_scans)
+    poses = [pose.copy()]
+    done = False
+    while not done and len(poses) < limit:
+        for _ in range(m.substeps):
+            d = route[target] - pose[:2]
+            while np.hypot(*d) <= tol:  # reached: aim at the next waypoint
+                if target == len(route) - 1:
+                    done = True
+                    break
+                target += 1
+                d = route[target] - pose[:2]
+            if done:
+                break
+            err = wrap_angle(np.arctan2(d[1], d[0]) - pose[2])
+            w = float(np.clip(m.turn_gain * err, -m.max_turn_rate, m.max_turn_rate))
+            v = m.speed * max(0.0, 1.0 - abs(err) / drive_angle)
+            mid = pose[2] + 0.5 * w * dt
+            pose = np.array(
+                [pose[0] + v * dt * np.cos(mid), pose[1] + v * dt * np.sin(mid), pose[2] + w * dt]
+            )
+            pose[2] = wrap_angle(pose[2])
+        poses.append(pose.copy())
+    if not done and max_scans is None:
+        raise RuntimeError(
+            f"the robot did not reach the end of route {world.name!r} within {limit} scans; "
+            "check the route and MotionParams"
+        )
+    return np.array(poses)
+
+
+# The defaults of simulate() (frozen, so safe to share).
+DEFAULT_LASER = LaserParams()
+DEFAULT_ODOMETRY = OdometryNoise()
+DEFAULT_MOTION = MotionParams()
+
+
+def simulate(
+    world: World,
+    seed: int = 0,
+    laser: LaserParams = DEFAULT_LASER,
+    odometry: OdometryNoise = DEFAULT_ODOMETRY,
+    motion: MotionParams = DEFAULT_MOTION,
+    max_scans: int | None = None,
+) -> Log:
+    """Drive ``world``'s route and record noisy scans and drifting odometry.
+
+    Parameters
+    ----------
+    world : World
+    seed : int
+        Seeds the laser and odometry noise (two independent streams, so changing the laser
+        does not change the odometry errors). The path itself is deterministic.
+    laser : LaserParams
+    odometry : OdometryNoise
+    motion : MotionParams
+    max_scans : int, optional
+        Stop after this many scans (default: at the end of the route).
+
+    Returns
+    -------
+    Log
+        ``timestamps[k] = round(k * scan_period, 6)``, noisy ``ranges`` (T, B), ``angles``
+        (B,), ``odometry`` (T, 3), and the simulation's ``truth`` (T, 3), ``hits`` (T, B)
+        and ``world``.
+    """
+    if max_scans is not None and (int(max_scans) != max_scans or max_scans < 1):
+        raise ValueError(f"max_scans must be a positive integer or None, got {max_scans!r}")
+    truth = follow_route(world, motion, max_scans)
+    laser_rng, odom_rng = (np.random.default_rng(s) for s in np.random.SeedSequence(seed).spawn(2))
+    angles = beam_angles(laser)
+    clean = np.empty((len(truth), len(angles)))
+    hits = np.empty((len(truth), len(angles)), dtype=np.intp)
+    for k, pose in enumerate(truth):
+        clean[k], hits[k] = cast_rays(world.walls, pose, angles, laser.max_range)
+    return Log(
+        name=world.name,
+        timestamps=np.array([round(k * motion.scan_period, 6) for k in range(len(truth))]),
+        ranges=add_range_noise(clean, hits, laser, laser_rng),
+        angles=angles,
+        odometry=odometry_from_truth(truth, odometry, odom_rng),
+        max_range=laser.max_range,
+        truth=truth,
+        hits=hits,
+        world=world,
+    )

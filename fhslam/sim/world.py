@@ -1,0 +1,398 @@
+"""Polygonal worlds: wall segments plus the route the simulated robot drives.
+
+A world is stored as JSON (see DESIGN.md)::
+
+    {"name": "office", "walls": [[x1, y1, x2, y2], ...], "route": [[x, y], ...],
+     "start": [x, y, theta]}
+
+in metres and radians; ``start`` is optional (default: the first waypoint, heading to the
+second). Built-in worlds: ``"paper"`` (:func:`paper_world`, the paper's 18.7 x 14.0 m office)
+and ``"random:SEED"`` (:func:`random_world`, held-out worlds nothing was tuned on).
+"""
+
+from __future__ import annotations
+
+import errno
+import json
+from dataclasses import dataclass
+from os import PathLike
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from fhslam.geometry import transform_points
+
+BUILTIN_WORLDS = ("paper", "random:SEED")
+
+
+class WorldFormatError(ValueError):
+    """A world definition (dict or JSON file) that is malformed; the message names the field."""
+
+
+def _array(value: Any, field: str, cols: int, min_rows: int) -> NDArray[np.float64]:
+    """Validate a list of rows of ``cols`` finite numbers, at least ``min_rows`` rows."""
+    try:
+        a = np.array(value, dtype=float)  # a copy: the world makes it read-only
+    except (TypeError, ValueError):
+        raise WorldFormatError(
+            f"field {field!r} must be a list of [{', '.join(['number'] * cols)}] rows"
+        ) from None
+    if a.ndim != 2 or a.shape[1] != cols:
+        raise WorldFormatError(f"field {field!r} must have shape (N, {cols}), got shape {a.shape}")
+    if len(a) < min_rows:
+        raise WorldFormatError(f"field {field!r} needs at least {min_rows} rows, got {len(a)}")
+    bad = ~np.isfinite(a).all(axis=1)
+    if bad.any():
+        i = int(np.flatnonzero(bad)[0])
+        raise WorldFormatError(f"field {field!r} row {i} is not finite: {a[i].tolist()}")
+    return a
+
+
+@dataclass(frozen=True, eq=False)
+class World:
+    """A polygonal environment and the route through it.
+
+    Attributes
+    ----------
+    name : str
+    walls : ndarray, shape (M, 4)
+        Wall segments ``[x1, y1, x2, y2]``, metres, each of non-zero length.
+    route : ndarray, shape (K, 2), K >= 2
+        Waypoints the robot drives through in order, metres.
+    start : ndarray, shape (3,)
+        Initial pose ``(x, y, theta)``; by default the first waypoint, facing the second.
+
+    Raises
+    ------
+    WorldFormatError
+        On wrong shapes, non-finite numbers, zero-length walls or a route of < 2 points.
+    """
+
+    name: str
+    walls: NDArray[np.float64]
+    route: NDArray[np.float64]
+    start: NDArray[np.float64] | None = None
+
+    def __post_init__(self) -> None:
+        if not isinstance(self.name, str):
+            raise WorldFormatError(f"field 'name' must be a string, got {self.name!r}")
+        walls = _array(self.walls, "walls", 4, 1)
+        short = np.hypot(walls[:, 2] - walls[:, 0], walls[:, 3] - walls[:, 1]) < 1e-9
+        if short.any():
+            i = int(np.flatnonzero(short)[0])
+            raise WorldFormatError(f"field 'walls' row {i} has zero length: {walls[i].tolist()}")
+        route = _array(self.route, "route", 2, 2)
+        if self.start is None:
+            d = route[1] - route[0]
+            if np.hypot(*d) == 0:
+                raise WorldFormatError(
+                    "field 'route': the first two waypoints coincide, so the start heading is "
+                    "undefined; give 'start' explicitly"
+                )
+            start = np.array([*route[0], np.arctan2(d[1], d[0])])
+        else:
+            try:
+                start = np.asarray(self.start, dtype=float)
+            except (TypeError, ValueError):
+                raise WorldFormatError("field 'start' must be [x, y, theta] numbers") from None
+            if start.shape != (3,):
+                raise WorldFormatError(
+                    f"field 'start' must be [x, y, theta] (shape (3,)), got shape {start.shape}"
+                )
+            if not np.isfinite(start).all():
+                raise WorldFormatError(f"field 'start' is not finite: {start.tolist()}")
+        for attr, value in (("walls", walls), ("route", route), ("start", start)):
+            value.flags.writeable = False
+            object.__setattr__(self, attr, value)
+
+    @classmethod
+    def from_dict(cls, d: dict[str, Any], source: str = "world") -> World:
+        """Build a world from the JSON structure; errors are prefixed with ``source``."""
+        try:
+            if not isinstance(d, dict):
+                raise WorldFormatError(
+                    f"expected a JSON object with 'name', 'walls', 'route', got {type(d).__name__}"
+                )
+            missing = [k for k in ("walls", "route") if k not in d]
+            if missing:
+                raise WorldFormatError(f"missing field {missing[0]!r}")
+            return cls(
+                name=d.get("name", Path(source).stem),
+                walls=d["walls"],
+                route=d["route"],
+                start=d.get("start"),
+            )
+        except WorldFormatError as e:
+            raise WorldFormatError(f"{source}: {e}") from None
+
+    def to_dict(self) -> dict[str, Any]:
+        """The JSON structure (plain lists), so that ``World.from_dict(w.to_dict())`` == ``w``."""
+        return {
+            "name": self.name,
+            "walls": self.walls.tolist(),
+            "route": self.route.tolist(),
+            "start": self.start.tolist(),
+        }
+
+    @property
+    def bounds(self) -> tuple[float, float, float, float]:
+        """``(xmin, ymin, xmax, ymax)`` of all walls and waypoints, metres."""
+        pts = np.vstack([self.walls[:, :2], self.walls[:, 2:], self.route])
+        (xmin, ymin), (xmax, ymax) = pts.min(axis=0), pts.max(axis=0)
+        return float(xmin), float(ymin), float(xmax), float(ymax)
+
+    @property
+    def route_length(self) -> float:
+        """Length of the route polyline, metres."""
+        return float(np.hypot(*np.diff(self.route, axis=0).T).sum())
+
+    def __repr__(self) -> str:
+        xmin, ymin, xmax, ymax = self.bounds
+        return (
+            f"World({self.name!r}: {len(self.walls)} walls, {len(self.route)} waypoints, "
+            f"route {self.route_length:.1f} m, {xmax - xmin:.1f} x {ymax - ymin:.1f} m)"
+        )
+
+
+# ----------------------------------------------------------------------------- geometry
+
+
+def _point_segment(p: NDArray, a: NDArray, b: NDArray) -> NDArray[np.float64]:
+    """Distance from points ``p`` to segments ``a``-``b``; all (..., 2), broadcast."""
+    ab = b - a
+    denom = np.maximum((ab * ab).sum(-1), 1e-300)
+    t = np.clip(((p - a) * ab).sum(-1) / denom, 0.0, 1.0)
+    return np.linalg.norm(p - (a + t[..., None] * ab), axis=-1)
+
+
+def segment_distances(s: ArrayLike, t: ArrayLike) -> NDArray[np.float64]:
+    """Shortest distance between every segment of ``s`` (N, 4) and of ``t`` (M, 4): (N, M).
+
+    Zero where two segments cross; otherwise the smallest endpoint-to-segment distance.
+    """
+    s = np.asarray(s, dtype=float).reshape(-1, 4)
+    t = np.asarray(t, dtype=float).reshape(-1, 4)
+    a, b = s[:, None, :2], s[:, None, 2:]
+    c, d = t[None, :, :2], t[None, :, 2:]
+    dist = np.minimum.reduce(
+        [_point_segment(a, c, d), _point_segment(b, c, d), _point_segment(c, a, b),
+         _point_segment(d, a, b)]
+    )  # fmt: skip
+
+    def cross(u: NDArray, v: NDArray) -> NDArray:
+        return u[..., 0] * v[..., 1] - u[..., 1] * v[..., 0]
+
+    crossing = (cross(b - a, c - a) * cross(b - a, d - a) < 0) & (
+        cross(d - c, a - c) * cross(d - c, b - c) < 0
+    )
+    return np.where(crossing, 0.0, dist)
+
+
+def route_segments(world: World) -> NDArray[np.float64]:
+    """The route as segments ``[x1, y1, x2, y2]``, shape (K-1, 4)."""
+    return np.hstack([world.route[:-1], world.route[1:]])
+
+
+def route_clearance(world: World) -> float:
+    """Smallest distance between the route polyline and any wall, metres."""
+    return float(segment_distances(route_segments(world), world.walls).min())
+
+
+def box_walls(cx: float, cy: float, w: float, h: float, angle_deg: float = 0.0) -> NDArray:
+    """The 4 walls (4, 4) of a ``w`` x ``h`` rectangle centred at ``(cx, cy)``, rotated."""
+    corners = np.array([[-w, -h], [w, -h], [w, h], [-w, h]]) / 2
+    c = transform_points([cx, cy, np.radians(angle_deg)], corners)
+    return np.hstack([c, np.roll(c, -1, axis=0)])
+
+
+def _polyline(*points: tuple[float, float]) -> NDArray:
+    """Walls along a polyline through ``points``."""
+    p = np.asarray(points, dtype=float)
+    return np.hstack([p[:-1], p[1:]])
+
+
+# ---------------------------------------------------------------------------- built-ins
+
+
+def paper_world() -> World:
+    """An 18.7 x 14.0 m office in the spirit of the paper's Fig. 13 (origin: lower-left corner).
+
+    A 2 m wide east-west corridor (y 6-8 m) with three rooms below (A, B, C) and three above
+    (D, E, F), doorways 1.0-1.2 m wide, box-shaped furniture (one rotated by 30 degrees, one
+    by 20), diagonal walls cutting the corners of rooms A and F, and two partial walls. The
+    route starts at S in room A, takes the corridor east, loops through room B, then room F,
+    and ends at E at the east end of the corridor; it keeps at least 0.5 m from every wall.
+    """
+    walls = [
+        # Outer rectangle.
+        _polyline((0, 0), (18.7, 0), (18.7, 14.0), (0, 14.0), (0, 0)),
+        # Corridor, south side (y = 6) with doors into A, B, C.
+        _polyline((0, 6), (3.0, 6)),
+        _polyline((4.1, 6), (9.0, 6)),
+        _polyline((10.2, 6), (15.0, 6)),
+        _polyline((16.0, 6), (18.7, 6)),
+        # Corridor, north side (y = 8) with doors into D, E, F.
+        _polyline((0, 8), (2.2, 8)),
+        _polyline((3.2, 8), (7.4, 8)),
+        _polyline((8.4, 8), (14.4, 8)),
+        _polyline((15.6, 8), (18.7, 8)),
+        # Partitions between rooms.
+        _polyline((6.0, 0), (6.0, 6)),
+        _polyline((12.2, 0), (12.2, 6)),
+        _polyline((5.5, 8), (5.5, 14)),
+        _polyline((11.5, 8), (11.5, 14)),
+        # Non-Manhattan: diagonal walls across the SW corner of A and the NE corner of F.
+        _polyline((0, 1.2), (1.2, 0)),
+        _polyline((16.6, 14.0), (18.7, 11.9)),
+        # Partial walls: an alcove in C, a half wall in E.
+        _polyline((17.0, 0), (17.0, 1.8), (18.0, 1.8)),
+        _polyline((5.5, 11.5), (7.5, 11.5)),
+        # Furniture.
+        box_walls(1.6, 4.4, 0.8, 0.6),  # A
+        box_walls(5.0, 1.1, 0.6, 0.5, 20.0),  # A, rotated
+        box_walls(9.2, 3.0, 1.0, 0.7, 30.0),  # B, rotated, inside the route's loop
+        box_walls(15.8, 3.2, 1.2, 0.8),  # C
+        box_walls(2.6, 11.4, 1.0, 1.0),  # D
+        box_walls(9.2, 11.0, 0.9, 0.6),  # E
+        box_walls(14.8, 10.75, 0.7, 0.5),  # F, inside the route's loop
+    ]
+    route = [
+        (1.5, 2.2),  # S, room A
+        (3.55, 2.2),
+        (3.55, 7.0),  # through A's door into the corridor
+        (9.6, 7.0),
+        (9.6, 4.5),  # through B's door
+        (7.3, 4.5),
+        (7.3, 1.5),
+        (11.0, 1.5),
+        (11.0, 4.5),
+        (9.6, 4.5),
+        (9.6, 7.0),  # back in the corridor
+        (15.0, 7.0),
+        (15.0, 9.6),  # through F's door
+        (17.4, 9.6),
+        (17.4, 11.0),
+        (12.8, 12.6),
+        (12.8, 9.6),
+        (15.0, 9.6),
+        (15.0, 7.0),  # back in the corridor
+        (17.6, 7.0),  # E
+    ]
+    return World(name="paper", walls=np.vstack(walls), route=np.array(route, dtype=float))
+
+
+def _inside_polygon(p: NDArray, poly: NDArray) -> NDArray[np.bool_]:
+    """Even-odd rule: which points ``p`` (N, 2) lie inside the closed polygon ``poly`` (V, 2)."""
+    a, b = poly, np.roll(poly, -1, axis=0)
+    x, y = p[:, None, 0], p[:, None, 1]
+    straddle = (a[:, 1] > y) != (b[:, 1] > y)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        x_cross = a[:, 0] + (y - a[:, 1]) * (b[:, 0] - a[:, 0]) / (b[:, 1] - a[:, 1])
+    return (straddle & (x < x_cross)).sum(axis=1) % 2 == 1
+
+
+def random_world(seed: int) -> World:
+    """A random polygonal world for held-out evaluation, deterministic for a given ``seed``.
+
+    The outer wall is a star-shaped polygon of 6-9 vertices at random angles and radii of
+    5-9 m around a centre at (9, 9), so walls meet at arbitrary angles. The route is the
+    same polygon shrunk by half toward the centre, driven once round as a closed loop. A few
+    spur walls stick in from the outer wall, stopping at least 1 m short of the route, and
+    3-6 boxes (0.4-1.2 m sides, random rotation) stand at least 0.6 m from the route and from
+    every other wall.
+    """
+    if isinstance(seed, bool) or not isinstance(seed, int | np.integer) or seed < 0:
+        raise ValueError(f"random_world seed must be a non-negative integer, got {seed!r}")
+    rng = np.random.default_rng(int(seed))
+    centre = np.array([9.0, 9.0])
+    for _ in range(100):  # redraw the outline until the route is well clear of it
+        n = int(rng.integers(6, 10))
+        gaps = rng.uniform(0.6, 1.4, n)
+        phi = rng.uniform(0, 2 * np.pi) + np.cumsum(gaps * (2 * np.pi / gaps.sum()))
+        radius = rng.uniform(5.0, 9.0, n)
+        outline = centre + radius[:, None] * np.column_stack([np.cos(phi), np.sin(phi)])
+        walls = np.hstack([outline, np.roll(outline, -1, axis=0)])
+        loop = centre + 0.5 * (outline - centre)
+        route = np.vstack([loop, loop[:1]])
+        route_segs = np.hstack([route[:-1], route[1:]])
+        if segment_distances(route_segs, walls).min() >= 1.5:
+            break
+    else:  # pragma: no cover (never happens for radii 5-9 m)
+        raise RuntimeError(f"random_world({seed}): could not draw a valid outline")
+
+    def clear(new: NDArray, margin: float) -> bool:
+        return bool(
+            segment_distances(new, route_segs).min() >= margin
+            and segment_distances(new, walls).min() >= margin
+        )
+
+    spurs = []
+    for _ in range(int(rng.integers(1, 4))):  # spur walls from the outline, pointing inward
+        i, t, length = int(rng.integers(n)), rng.uniform(0.25, 0.75), rng.uniform(0.6, 1.8)
+        a, b = outline[i], outline[(i + 1) % n]
+        foot = a + t * (b - a)
+        inward = np.array([a[1] - b[1], b[0] - a[0]]) / np.hypot(*(b - a))  # left normal
+        if np.dot(centre - foot, inward) < 0:
+            inward = -inward
+        spur = np.hstack([foot, foot + length * inward])[None]
+        if segment_distances(spur, route_segs).min() >= 1.0:
+            spurs.append(spur)
+    walls = np.vstack([walls, *spurs])
+
+    lo, hi = outline.min(axis=0), outline.max(axis=0)
+    for _ in range(int(rng.integers(3, 7))):  # boxes, by rejection sampling
+        for _ in range(200):
+            c = rng.uniform(lo, hi)
+            w, h = rng.uniform(0.4, 1.2, 2)
+            box = box_walls(c[0], c[1], w, h, rng.uniform(0.0, 180.0))
+            if _inside_polygon(c[None], outline)[0] and clear(box, 0.6):
+                walls = np.vstack([walls, box])
+                break
+    return World(name=f"random:{seed}", walls=walls, route=route)
+
+
+def load_world(name_or_path: str | PathLike[str]) -> World:
+    """A built-in world by name, or a world JSON file.
+
+    Parameters
+    ----------
+    name_or_path : str or path-like
+        ``"paper"``, ``"random:SEED"`` (e.g. ``"random:3"``), or the path of a JSON file
+        ``{"name": ..., "walls": [[x1, y1, x2, y2], ...], "route": [[x, y], ...],
+        "start": [x, y, theta]}`` (``start`` optional).
+
+    Raises
+    ------
+    ValueError
+        For an unknown built-in name (the message lists the built-ins).
+    FileNotFoundError
+        For a path (ends in ``.json`` or contains a directory separator) that does not exist.
+    WorldFormatError
+        For a file that is not valid JSON or has a malformed field; names the file and field.
+    """
+    text = str(name_or_path)
+    if not isinstance(name_or_path, PathLike):
+        if text == "paper":
+            return paper_world()
+        if text.startswith("random:"):
+            seed = text.removeprefix("random:")
+            if not seed.isdigit():
+                raise ValueError(
+                    f"world {text!r}: the seed after 'random:' must be a non-negative integer"
+                )
+            return random_world(int(seed))
+    path = Path(name_or_path)
+    if not path.is_file():
+        if isinstance(name_or_path, PathLike) or path.suffix or len(path.parts) > 1:
+            raise FileNotFoundError(errno.ENOENT, "world file not found", str(path))
+        raise ValueError(
+            f"unknown world {text!r}: built-in worlds are {', '.join(BUILTIN_WORLDS)}; "
+            "or give the path of a world JSON file"
+        )
+    try:
+        data = json.loads(path.read_text(encoding="utf-8"))
+    except (json.JSONDecodeError, UnicodeDecodeError) as e:
+        raise WorldFormatError(f"{path}: not valid JSON ({e})") from None
+    return World.from_dict(data, source=str(path))

@@ -1,0 +1,51 @@
+"""Shared fixtures: small worlds built in the test, and the location of the real logs."""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+ROOM = np.array([[0, 0, 6, 0], [6, 0, 6, 4], [6, 4, 0, 4], [0, 4, 0, 0]], dtype=float)
+"""A 6 m x 4 m rectangular room, walls [x1, y1, x2, y2]."""
+
+
+def cast(walls: np.ndarray, pose, n_beams: int = 181, noise: float = 0.01, seed: int = 0):
+    """Ranges of a 180° laser at ``pose`` in a world of wall segments (test-only caster)."""
+    x, y, th = pose
+    a = np.radians(np.linspace(-90, 90, n_beams))
+    d = np.column_stack([np.cos(a + th), np.sin(a + th)])
+    p, q = walls[:, :2], walls[:, 2:]
+    e = q - p
+    denom = d[:, None, 0] * e[None, :, 1] - d[:, None, 1] * e[None, :, 0]
+    w = p[None] - np.array([x, y])
+    with np.errstate(divide="ignore", invalid="ignore"):
+        t = (w[..., 0] * e[None, :, 1] - w[..., 1] * e[None, :, 0]) / denom
+        s = (w[..., 0] * d[:, None, 1] - w[..., 1] * d[:, None, 0]) / denom
+    t = np.where((t > 0) & (s >= 0) & (s <= 1), t, np.inf)
+    r = t.min(axis=1) + np.random.default_rng(seed).normal(0, noise, n_beams)
+    return r, a
+
+
+def room_points(pose=(2.0, 1.5, 0.3), noise=0.01, seed=0):
+    """Laser-frame points of a scan in ROOM."""
+    r, a = cast(ROOM, pose, noise=noise, seed=seed)
+    return np.column_stack([r * np.cos(a), r * np.sin(a)])
+
+
+def data_dir() -> Path | None:
+    """The shared real-data folder ($FHSLAM_DATA, else ../shared/data beside the repo)."""
+    env = os.environ.get("FHSLAM_DATA")
+    candidates = [Path(env)] if env else []
+    candidates.append(Path(__file__).resolve().parents[2] / "shared" / "data")
+    return next((c for c in candidates if c.is_dir()), None)
+
+
+@pytest.fixture
+def real_data() -> Path:
+    d = data_dir()
+    if d is None:
+        pytest.skip("no real laser logs: set FHSLAM_DATA or place them in ../shared/data")
+    return d

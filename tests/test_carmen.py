@@ -1,0 +1,263 @@
+"""Tests of the CARMEN log and trajectory file readers and writers."""
+
+from __future__ import annotations
+
+import os
+import re
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from fhslam.io import (
+    CarmenFormatError,
+    Log,
+    TrajectoryFormatError,
+    flaser_angles,
+    read_carmen,
+    read_trajectory,
+    write_carmen,
+    write_trajectory,
+)
+from fhslam.sim import LaserParams, paper_world, simulate
+
+
+def data_file(name: str) -> Path:
+    """A shared dataset: ``$FHSLAM_DATA/name`` or ``../shared/data/name`` beside the repo."""
+    folders = [Path(os.environ["FHSLAM_DATA"])] if os.environ.get("FHSLAM_DATA") else []
+    folders.append(Path(__file__).resolve().parents[2] / "shared" / "data")
+    for folder in folders:
+        if (folder / name).is_file():
+            return folder / name
+    pytest.skip(f"dataset {name} not found in {', '.join(map(str, folders))} (set $FHSLAM_DATA)")
+
+
+@pytest.fixture(scope="module")
+def sim_log() -> Log:
+    return simulate(paper_world(), seed=0, max_scans=60)
+
+
+def test_round_trip_is_exact(sim_log, tmp_path):
+    path = tmp_path / "paper.clf"
+    write_carmen(sim_log, path)
+    back = read_carmen(path)
+    assert back.name == "paper" and len(back) == 60
+    for field in ("timestamps", "ranges", "angles", "odometry"):
+        assert np.array_equal(getattr(back, field), getattr(sim_log, field)), field
+    assert back.max_range == 8.0
+    assert back.truth is None and back.hits is None and back.world is None
+
+
+def test_written_log_carries_odometry_not_truth(sim_log, tmp_path):
+    path = tmp_path / "paper.clf"
+    write_carmen(sim_log, path)
+    lines = path.read_text().splitlines()
+    assert lines[0].startswith("#")
+    flaser = [ln.split() for ln in lines if ln.startswith("FLASER")]
+    odom = [ln.split() for ln in lines if ln.startswith("ODOM")]
+    assert len(flaser) == len(odom) == 60
+    k = 40  # a scan after the odometry has drifted from the truth
+    assert not np.allclose(sim_log.odometry[k], sim_log.truth[k])
+    fields = flaser[k]
+    assert fields[1] == "181" and len(fields) == 181 + 11
+    pose = np.array(fields[183:189], dtype=float)
+    assert np.array_equal(pose, np.r_[sim_log.odometry[k], sim_log.odometry[k]])
+    assert fields[-2] == "fhslam" and fields[-1] == fields[-3] == repr(float(sim_log.timestamps[k]))
+    assert np.array_equal(np.array(odom[k][1:4], dtype=float), sim_log.odometry[k])
+
+
+def test_other_fields_of_view_round_trip_through_robotlaser1(tmp_path):
+    laser = LaserParams(n_beams=271, fov_deg=270.0, max_range=10.0)
+    log = simulate(paper_world(), seed=2, laser=laser, max_scans=5)
+    path = tmp_path / "wide.clf"
+    write_carmen(log, path)
+    assert "ROBOTLASER1" in path.read_text()
+    back = read_carmen(path)
+    for field in ("timestamps", "ranges", "odometry"):
+        assert np.array_equal(getattr(back, field), getattr(log, field)), field
+    np.testing.assert_allclose(back.angles, log.angles, rtol=0, atol=1e-12)
+    assert back.max_range == 10.0
+
+
+def test_flaser_angle_convention():
+    np.testing.assert_allclose(np.diff(flaser_angles(181)), np.radians(1.0), atol=1e-12)
+    np.testing.assert_allclose(np.diff(flaser_angles(361)), np.radians(0.5), atol=1e-12)
+    np.testing.assert_allclose(np.diff(flaser_angles(180)), np.pi / 179, atol=1e-12)
+    assert flaser_angles(181)[0] == -np.pi / 2 and flaser_angles(181)[-1] == np.pi / 2
+
+
+def test_read_mit_csail():
+    log = read_carmen(data_file("mit-csail.clf"))
+    assert len(log) == 1988 and log.ranges.shape == (1988, 361)
+    np.testing.assert_allclose(np.diff(log.angles), np.radians(0.5), atol=1e-12)
+    # First FLASER line of the file.
+    assert log.timestamps[0] == 1134864629.895182
+    assert log.odometry[0].tolist() == [576.536523, 0.106594, -2.255213]
+    assert log.ranges[0, :3].tolist() == [1.40, 1.39, 1.39]
+    assert log.max_range == pytest.approx(81.91)  # the log's "no return" reading
+    assert log.timestamps[-1] - log.timestamps[0] == pytest.approx(424.0, abs=0.05)
+    assert np.all(np.diff(log.timestamps) > 0)
+
+
+# ---------------------------------------------------------------------------- hand-made logs
+
+GOOD = """\
+# a small log
+PARAM robot_front_laser_max 8.0 0.0 host 0.0
+
+ODOM 0.0 0.0 0.0 0.0 0.0 0.0 0.5 host 0.5
+FLASER 5 1.0 1.5 2.0 2.5 3.0 0.0 0.0 0.0 0.0 0.0 0.0 1.0 host 1.0
+SYNC something 1.1 host 1.1
+FLASER 5 1.1 1.6 2.1 2.6 3.1 0.1 0.0 0.01 0.1 0.0 0.01 1.2 host 1.2
+FLASER 5 1.2 1.7 2.2 2.7 3.2 0.2 0.0 0.02 0.2 0.0 0.02 1.4 host 1.4
+"""
+
+
+def test_read_skips_comments_blank_lines_and_other_messages(tmp_path):
+    path = tmp_path / "small.clf"
+    path.write_text(GOOD)
+    log = read_carmen(path)
+    assert log.timestamps.tolist() == [1.0, 1.2, 1.4]
+    assert log.ranges.shape == (3, 5) and log.ranges[2].tolist() == [1.2, 1.7, 2.2, 2.7, 3.2]
+    assert log.odometry[1].tolist() == [0.1, 0.0, 0.01]
+    assert np.array_equal(log.angles, np.linspace(-np.pi / 2, np.pi / 2, 5))
+    assert log.max_range == 8.0  # max(8.0, largest reading 3.2)
+    assert read_carmen(path, max_range=4.0).max_range == 4.0
+
+
+# (replacement for line 7 of GOOD, expected message fragment)
+BAD_LINES = {
+    "truncated": ("FLASER 5 1.1 1.6 2.1", "truncated FLASER line"),
+    "truncated tail": ("FLASER 5 1.1 1.6 2.1 2.6 3.1 0.1 0.0 0.01 0.1", "truncated"),
+    "non-numeric range": (
+        "FLASER 5 1.1 1.6 abc 2.6 3.1 0.1 0.0 0.01 0.1 0.0 0.01 1.2 host 1.2",
+        "non-numeric range reading 'abc'",
+    ),
+    "non-numeric count": (
+        "FLASER five 1.1 1.6 2.1 2.6 3.1 0.1 0.0 0.01 0.1 0.0 0.01 1.2 host 1.2",
+        "num_readings must be an integer",
+    ),
+    "wrong count": (
+        "FLASER 6 1.1 1.6 2.1 2.6 3.1 0.1 0.0 0.01 0.1 0.0 0.01 1.2 host 1.2",
+        "wrong reading count: FLASER num_readings is 6 but the line holds 5",
+    ),
+    "nan pose": (
+        "FLASER 5 1.1 1.6 2.1 2.6 3.1 0.1 0.0 0.01 nan 0.0 0.01 1.2 host 1.2",
+        "non-finite pose",
+    ),
+    "inf timestamp": (
+        "FLASER 5 1.1 1.6 2.1 2.6 3.1 0.1 0.0 0.01 0.1 0.0 0.01 inf host 1.2",
+        "non-finite ipc_timestamp",
+    ),
+    "beam count changes": (
+        "FLASER 4 1.1 1.6 2.1 2.6 0.1 0.0 0.01 0.1 0.0 0.01 1.2 host 1.2",
+        "has 4 readings but the first scan \\(line 5\\) has 5",
+    ),
+}
+
+
+@pytest.mark.parametrize("case", list(BAD_LINES))
+def test_malformed_lines_name_file_and_line(tmp_path, case):
+    replacement, fragment = BAD_LINES[case]
+    lines = GOOD.splitlines()
+    assert lines[6].startswith("FLASER")  # line 7 of the file
+    lines[6] = replacement
+    path = tmp_path / "broken.clf"
+    path.write_text("\n".join(lines) + "\n")
+    with pytest.raises(CarmenFormatError, match=rf"^{re.escape(str(path))}:7: .*{fragment}"):
+        read_carmen(path)
+
+
+def test_file_without_laser_messages(tmp_path):
+    path = tmp_path / "odom_only.clf"
+    path.write_text("# header\nODOM 0 0 0 0 0 0 1.0 host 1.0\n")
+    with pytest.raises(CarmenFormatError, match=r"odom_only\.clf: no FLASER or ROBOTLASER1"):
+        read_carmen(path)
+
+
+def test_missing_file(tmp_path):
+    with pytest.raises(FileNotFoundError, match=r"missing\.clf"):
+        read_carmen(tmp_path / "missing.clf")
+
+
+def test_binary_file_is_a_format_error(tmp_path):
+    path = tmp_path / "data.bag"
+    path.write_bytes(b"#ROSBAG V2.0\n\xff\xfe\x00\x01" * 10)
+    with pytest.raises(CarmenFormatError, match=r"data\.bag: not a CARMEN text log"):
+        read_carmen(path)
+
+
+def robotlaser1(ranges, remissions, robot_pose, stamp):
+    """A ROBOTLASER1 line: start -90 deg, fov 180, resolution 45 deg, max range 20 m."""
+    head = f"ROBOTLASER1 0 {-np.pi / 2!r} {np.pi!r} {np.pi / 4!r} 20.0 0.01 0 {len(ranges)}"
+    rem = "" if remissions is None else f" {len(remissions)} " + " ".join(map(str, remissions))
+    pose = " ".join(map(str, robot_pose))
+    return (
+        f"{head} {' '.join(map(str, ranges))}{rem} 9 9 9 {pose} 0.1 0.0 0.5 0.3 0.0 "
+        f"{stamp} host {stamp}"
+    )
+
+
+def test_read_robotlaser1_with_and_without_remissions(tmp_path):
+    path = tmp_path / "robot.clf"
+    path.write_text(
+        "ODOM 0 0 0 0 0 0 0.9 host 0.9\n"
+        + robotlaser1([1, 2, 3, 4, 5], [7, 7, 7, 7, 7], [1.0, 2.0, 0.5], 1.0)
+        + "\n"
+        + robotlaser1([2, 3, 4, 5, 6], None, [1.5, 2.0, 0.5], 2.0)
+        + "\n"
+        + robotlaser1([3, 4, 5, 6, 7], [], [2.0, 2.0, 0.5], 3.0)
+        + "\n"
+    )
+    log = read_carmen(path)
+    assert log.timestamps.tolist() == [1.0, 2.0, 3.0]
+    assert log.odometry.tolist() == [[1.0, 2.0, 0.5], [1.5, 2.0, 0.5], [2.0, 2.0, 0.5]]
+    assert log.ranges[1].tolist() == [2, 3, 4, 5, 6]
+    np.testing.assert_allclose(log.angles, np.radians([-90, -45, 0, 45, 90]), atol=1e-12)
+    assert log.max_range == 20.0
+
+
+def test_robotlaser1_wrong_count(tmp_path):
+    line = robotlaser1([1, 2, 3, 4, 5], [7, 7, 7], [1.0, 2.0, 0.5], 1.0)
+    path = tmp_path / "robot.clf"
+    path.write_text("# c\n" + line.replace(" 0 5 ", " 0 6 ", 1) + "\n")
+    with pytest.raises(CarmenFormatError, match=r"robot\.clf:2: "):
+        read_carmen(path)
+
+
+# ---------------------------------------------------------------------------- trajectories
+
+
+def test_trajectory_round_trip_is_exact(sim_log, tmp_path):
+    path = tmp_path / "truth.txt"
+    write_trajectory(path, sim_log.timestamps, sim_log.truth, header="ground truth\nworld paper")
+    text = path.read_text().splitlines()
+    assert text[:2] == ["# ground truth", "# world paper"]
+    t, poses = read_trajectory(path)
+    assert np.array_equal(t, sim_log.timestamps) and np.array_equal(poses, sim_log.truth)
+
+
+@pytest.mark.parametrize(
+    ("line", "fragment"),
+    [
+        ("0.2 1.0 2.0", "expected 4 fields"),
+        ("0.2 1.0 two 0.0", "non-numeric value 'two'"),
+        ("0.2 1.0 2.0 nan", "non-finite value"),
+    ],
+)
+def test_trajectory_errors_name_file_and_line(tmp_path, line, fragment):
+    path = tmp_path / "traj.txt"
+    path.write_text(f"# header\n0.0 0 0 0\n\n{line}\n")
+    with pytest.raises(TrajectoryFormatError, match=rf"traj\.txt:4: {fragment}"):
+        read_trajectory(path)
+
+
+def test_trajectory_empty_and_missing(tmp_path):
+    path = tmp_path / "empty.txt"
+    path.write_text("# nothing\n")
+    with pytest.raises(TrajectoryFormatError, match=r"empty\.txt: no poses"):
+        read_trajectory(path)
+    with pytest.raises(FileNotFoundError, match=r"absent\.txt"):
+        read_trajectory(tmp_path / "absent.txt")
+    with pytest.raises(ValueError, match="poses must have shape"):
+        write_trajectory(path, [0.0, 1.0], [[0.0, 0.0, 0.0]])

@@ -1,0 +1,276 @@
+"""Tests of the simulator: worlds, ray casting, range noise, odometry drift, route following."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+from fhslam.geometry import point_segment_distance
+from fhslam.sim import (
+    LaserParams,
+    OdometryNoise,
+    World,
+    WorldFormatError,
+    add_range_noise,
+    beam_angles,
+    cast_rays,
+    load_world,
+    odometry_from_truth,
+    paper_world,
+    random_world,
+    route_clearance,
+    simulate,
+)
+from fhslam.sim.simulate import follow_route
+
+# A 4 x 4 m room centred on the origin: bottom, right, top, left.
+SQUARE = np.array([[-2, -2, 2, -2], [2, -2, 2, 2], [2, 2, -2, 2], [-2, 2, -2, -2]], dtype=float)
+
+
+def wall_distances(points: np.ndarray, walls: np.ndarray) -> np.ndarray:
+    """Distance of each point (N, 2) to the nearest wall, by geometry.point_segment_distance."""
+    return np.min([point_segment_distance(points, w[:2], w[2:]) for w in walls], axis=0)
+
+
+def dense_route(world: World, step: float = 0.01) -> np.ndarray:
+    """Points every ``step`` metres along the route polyline."""
+    pts = []
+    for a, b in zip(world.route[:-1], world.route[1:], strict=True):
+        n = max(2, int(np.ceil(np.hypot(*(b - a)) / step)) + 1)
+        pts.append(a + np.linspace(0, 1, n)[:, None] * (b - a))
+    return np.vstack(pts)
+
+
+@pytest.fixture(scope="module")
+def paper_log():
+    return simulate(paper_world(), seed=0)
+
+
+# ---------------------------------------------------------------------------- ray casting
+
+
+def test_beam_angles_default_is_the_papers_181_beams_at_one_degree():
+    a = beam_angles(LaserParams())
+    assert a.shape == (181,)
+    np.testing.assert_allclose(a[[0, 90, 180]], [-np.pi / 2, 0.0, np.pi / 2], atol=1e-15)
+    np.testing.assert_allclose(np.diff(a), np.radians(1.0), atol=1e-12)
+
+
+def test_cast_rays_square_room_from_the_centre():
+    angles = np.radians([0.0, 45.0, 90.0, -90.0, 180.0, -135.0])
+    r, hit = cast_rays(SQUARE, [0.0, 0.0, 0.0], angles, max_range=8.0)
+    # Tolerance 1e-12 m: the intersection is exact up to rounding.
+    np.testing.assert_allclose(r, [2.0, 2 * np.sqrt(2), 2.0, 2.0, 2.0, 2 * np.sqrt(2)], atol=1e-12)
+    assert hit[0] == 1  # straight ahead (+x): the right wall
+    assert hit[2] == 2 and hit[3] == 0 and hit[4] == 3  # top, bottom, left
+    assert hit[1] in (1, 2)  # the 45 degree beam hits the corner shared by right and top
+
+
+def test_cast_rays_respects_the_robot_pose():
+    # At (1, 0) facing +y: ahead is the top wall 2 m away, to the right (-90 deg) the right wall.
+    r, hit = cast_rays(SQUARE, [1.0, 0.0, np.pi / 2], np.radians([0.0, -90.0, 90.0]), 8.0)
+    np.testing.assert_allclose(r, [2.0, 1.0, 3.0], atol=1e-12)
+    assert hit.tolist() == [2, 1, 3]
+
+
+def test_cast_rays_no_return_reads_max_range_and_wall_minus_one():
+    wall = np.array([[5.0, -1.0, 5.0, 1.0]])  # one wall 5 m ahead
+    angles = np.radians([0.0, 90.0, 180.0])
+    r, hit = cast_rays(wall, [0.0, 0.0, 0.0], angles, max_range=8.0)
+    assert r[0] == pytest.approx(5.0, abs=1e-12) and hit[0] == 0
+    assert r[1] == 8.0 and r[2] == 8.0  # exactly max_range: sideways and behind
+    assert hit[1] == -1 and hit[2] == -1
+    # The same wall beyond the maximum range is no return either.
+    r, hit = cast_rays(wall, [0.0, 0.0, 0.0], angles, max_range=4.0)
+    assert r.tolist() == [4.0, 4.0, 4.0] and hit.tolist() == [-1, -1, -1]
+    # No walls at all.
+    r, hit = cast_rays(np.zeros((0, 4)), [0.0, 0.0, 0.0], angles, max_range=8.0)
+    assert r.tolist() == [8.0, 8.0, 8.0] and hit.tolist() == [-1, -1, -1]
+
+
+def test_noisy_hits_stay_inside_the_open_range_and_no_returns_stay_exact():
+    params = LaserParams()
+    clean = np.array([7.9995] * 5000 + [8.0] * 10 + [0.0005] * 5000)
+    hit = np.array([0] * 5000 + [-1] * 10 + [0] * 5000)
+    noisy = add_range_noise(clean, hit, params, np.random.default_rng(0))
+    assert np.all(noisy[hit >= 0] > 0) and np.all(noisy[hit >= 0] < params.max_range)
+    assert np.all(noisy[hit < 0] == params.max_range)
+
+
+def test_range_noise_std_matches_the_parameter(paper_log):
+    # Re-cast noise-free ranges from the true poses; the residual is the added noise.
+    log, params = paper_log, LaserParams()
+    clean = np.array(
+        [cast_rays(log.world.walls, p, log.angles, params.max_range)[0] for p in log.truth]
+    )
+    hits = log.hits >= 0
+    residual = (log.ranges - clean)[hits & (clean < params.max_range - 0.05)]
+    assert residual.size > 100_000
+    assert np.std(residual) == pytest.approx(params.range_noise_std, rel=0.10)
+    assert abs(np.mean(residual)) < 0.001
+    assert np.all(log.ranges[~hits] == params.max_range)
+    # Quantised to the 1 mm resolution.
+    np.testing.assert_allclose(log.ranges * 1000, np.round(log.ranges * 1000), atol=1e-6)
+
+
+# ---------------------------------------------------------------------------- odometry
+
+
+def test_odometry_without_noise_equals_truth(paper_log):
+    odom = odometry_from_truth(paper_log.truth, OdometryNoise.none(), np.random.default_rng(0))
+    # Chaining ~900 relative steps is exact up to rounding: 1e-9 m / rad.
+    np.testing.assert_allclose(odom, paper_log.truth, rtol=0, atol=1e-9)
+    assert np.array_equal(odom[0], paper_log.truth[0])
+
+
+def test_odometry_drifts_with_default_noise(paper_log):
+    err = np.hypot(*(paper_log.odometry[:, :2] - paper_log.truth[:, :2]).T)
+    assert np.array_equal(paper_log.odometry[0], paper_log.truth[0])
+    assert err[-1] > 0.2
+    # Drift accumulates: the error at the end exceeds the error over the first tenth.
+    assert err[-1] > err[: len(err) // 10].max()
+
+
+def test_simulation_is_deterministic_per_seed(paper_log):
+    again = simulate(paper_world(), seed=0)
+    other = simulate(paper_world(), seed=1)
+    for field in ("timestamps", "ranges", "odometry", "truth", "hits"):
+        assert np.array_equal(getattr(again, field), getattr(paper_log, field)), field
+    assert np.array_equal(other.truth, paper_log.truth)  # the path is noise-free
+    assert not np.array_equal(other.ranges, paper_log.ranges)
+    assert not np.array_equal(other.odometry, paper_log.odometry)
+
+
+def test_odometry_noise_validation():
+    with pytest.raises(ValueError, match="alpha3"):
+        OdometryNoise(alpha3=-0.1)
+
+
+# ---------------------------------------------------------------------------- simulate
+
+
+def test_simulate_paper_world(paper_log):
+    log, world = paper_log, paper_world()
+    assert log.ranges.shape == (len(log), 181) and log.angles.shape == (181,)
+    assert 500 < len(log) < 2000
+    assert log.timestamps[0] == 0.0 and np.all(np.diff(log.timestamps) > 0)
+    assert log.timestamps.tolist() == [round(k * 0.2, 6) for k in range(len(log))]
+    assert np.hypot(*(log.truth[-1, :2] - world.route[-1])) < 0.5
+    assert np.array_equal(log.truth[0], world.start)
+    assert wall_distances(log.truth[:, :2], world.walls).min() >= 0.3
+
+
+def test_simulate_max_scans():
+    log = simulate(paper_world(), seed=0, max_scans=10)
+    assert len(log) == 10 and log.ranges.shape == (10, 181)
+    with pytest.raises(ValueError, match="max_scans"):
+        simulate(paper_world(), max_scans=0)
+
+
+def test_simulate_custom_laser():
+    laser = LaserParams(n_beams=361, fov_deg=270.0, max_range=5.0)
+    log = simulate(paper_world(), laser=laser, max_scans=5)
+    assert log.ranges.shape == (5, 361) and log.max_range == 5.0
+    assert log.angles[0] == pytest.approx(-np.radians(135.0), abs=1e-12)
+
+
+def test_laser_params_validation():
+    with pytest.raises(ValueError, match="n_beams"):
+        LaserParams(n_beams=1)
+    with pytest.raises(ValueError, match="max_range"):
+        LaserParams(max_range=0.0)
+
+
+# ---------------------------------------------------------------------------- worlds
+
+
+def test_paper_world_layout():
+    w = paper_world()
+    assert w.bounds == (0.0, 0.0, 18.7, 14.0)
+    assert 40 <= len(w.walls) <= 70
+    angles = np.degrees(np.arctan2(w.walls[:, 3] - w.walls[:, 1], w.walls[:, 2] - w.walls[:, 0]))
+    off_axis = np.abs(((angles + 45) % 90) - 45) > 1.0
+    assert off_axis.sum() >= 3  # a diagonal wall and rotated boxes: not purely Manhattan
+    assert 50 < w.route_length < 100
+
+
+def test_paper_route_keeps_half_a_metre_from_walls():
+    w = paper_world()
+    assert wall_distances(dense_route(w), w.walls).min() >= 0.5
+    assert route_clearance(w) >= 0.5
+
+
+@pytest.mark.parametrize("seed", range(8))
+def test_random_world_is_clear_and_deterministic(seed):
+    w = random_world(seed)
+    again = random_world(seed)
+    assert np.array_equal(w.walls, again.walls) and np.array_equal(w.route, again.route)
+    assert np.array_equal(w.route[0], w.route[-1])  # a closed loop
+    assert wall_distances(dense_route(w), w.walls).min() >= 0.6
+    assert len(w.walls) >= 6 + 3 * 4  # outline + at least 3 boxes
+
+
+def test_random_worlds_differ_and_can_be_driven():
+    a, b = random_world(1), random_world(2)
+    assert a.walls.shape != b.walls.shape or not np.allclose(a.walls, b.walls)
+    truth = follow_route(a)
+    assert wall_distances(truth[:, :2], a.walls).min() >= 0.3
+    assert np.hypot(*(truth[-1, :2] - a.route[-1])) < 0.5
+
+
+def test_world_dict_round_trip_and_default_start():
+    w = World.from_dict({"name": "t", "walls": SQUARE.tolist(), "route": [[0, 0], [1, 1]]})
+    np.testing.assert_allclose(w.start, [0.0, 0.0, np.pi / 4], atol=1e-15)
+    back = World.from_dict(json.loads(json.dumps(w.to_dict())))
+    assert back.name == "t"
+    for field in ("walls", "route", "start"):
+        assert np.array_equal(getattr(back, field), getattr(w, field))
+    assert w.bounds == (-2.0, -2.0, 2.0, 2.0)
+
+
+def test_load_world_builtins_and_files(tmp_path):
+    assert load_world("paper").name == "paper"
+    assert np.array_equal(load_world("random:3").walls, random_world(3).walls)
+    path = tmp_path / "room.json"
+    path.write_text(json.dumps({"name": "room", "walls": SQUARE.tolist(), "route": [[0, 0], [1, 0]],
+                                "start": [0, 0, 0.5]}))  # fmt: skip
+    w = load_world(path)
+    assert w.name == "room" and w.start.tolist() == [0.0, 0.0, 0.5]
+    assert load_world(str(path)).name == "room"
+
+
+def test_load_world_unknown_name_lists_builtins():
+    with pytest.raises(ValueError, match=r"unknown world 'office'.*paper.*random:SEED"):
+        load_world("office")
+    with pytest.raises(ValueError, match="seed"):
+        load_world("random:x")
+
+
+def test_load_world_missing_file(tmp_path):
+    with pytest.raises(FileNotFoundError, match=r"nope\.json"):
+        load_world(tmp_path / "nope.json")
+    with pytest.raises(FileNotFoundError, match=r"nope\.json"):
+        load_world("nope.json")
+
+
+@pytest.mark.parametrize(
+    ("content", "match"),
+    [
+        ("{not json", "not valid JSON"),
+        ('{"walls": [[0, 0, 1]], "route": [[0, 0], [1, 0]]}', r"'walls' must have shape \(N, 4\)"),
+        ('{"walls": [[0, 0, 1, 1]], "route": [[0, 0]]}', "'route' needs at least 2 rows"),
+        ('{"walls": [[0, 0, 1, 1]]}', "missing field 'route'"),
+        ('{"walls": [[0, 0, 0, 0]], "route": [[0, 0], [1, 0]]}', "'walls' row 0 has zero length"),
+        ('{"walls": [[0, 0, NaN, 1]], "route": [[0, 0], [1, 0]]}', "'walls' row 0 is not finite"),
+        ('{"walls": [[0, 0, 1, 1]], "route": [[0, 0], [1, 0]], "start": [0, 0]}', "'start'"),
+        ('{"walls": [["a", 0, 1, 1]], "route": [[0, 0], [1, 0]]}', "'walls' must be a list"),
+        ("[1, 2]", "expected a JSON object"),
+    ],
+)
+def test_load_world_malformed_files_name_file_and_field(tmp_path, content, match):
+    path = tmp_path / "bad_world.json"
+    path.write_text(content)
+    with pytest.raises(WorldFormatError, match=rf"bad_world\.json: .*{match}"):
+        load_world(path)

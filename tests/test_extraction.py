@@ -89,7 +89,7 @@ def test_restricted_hough_finds_the_line_inside_its_window():
     peaks = restricted_hough(p, np.zeros(80, int), [th0 - np.pi / 2 + np.radians(1.0)], params)
     drho, dth = line_difference(peaks.rho[0], peaks.theta[0], rho0, th0)
     assert drho <= 0.01 and np.degrees(dth) <= 0.25 + 1e-9  # within half a cell
-    acc, thetas, rhos = peaks.accumulators[0]
+    acc, _thetas, rhos = peaks.accumulators[0]
     assert acc.shape == (13, len(rhos)) and acc.max() == peaks.votes[0] == 80
 
 
@@ -166,7 +166,7 @@ def test_one_huge_cluster_holds_several_lines():
 def test_non_finite_points_raise_a_clear_error(bad):
     p = room_points()
     p[7, 1] = bad
-    with pytest.raises(ValueError, match="non-finite rows .* index 7"):
+    with pytest.raises(ValueError, match=r"non-finite rows .* index 7"):
         extract_lines(p)
 
 

@@ -29,6 +29,24 @@ def _simulate(args: argparse.Namespace) -> None:
     print(f"wrote {len(log)} scans to {args.log} and the true poses to {args.truth}")
 
 
+def _info(args: argparse.Namespace) -> None:
+    import numpy as np
+
+    from fhslam.extraction import extract_lines, scan_to_points
+    from fhslam.io import read_carmen
+
+    log = read_carmen(args.log)
+    step = np.hypot(*np.diff(log.odometry[:, :2], axis=0).T).sum()
+    sample = range(0, len(log), max(1, len(log) // 200))
+    n_lines = [
+        len(extract_lines(scan_to_points(log.ranges[k], log.angles, log.max_range)[0]))
+        for k in sample
+    ]
+    print(f"{args.log}: {len(log)} scans of {len(log.angles)} beams")
+    print(f"time span {log.timestamps[-1] - log.timestamps[0]:.1f} s, odometry path {step:.1f} m")
+    print(f"fast Hough lines per scan (median of {len(n_lines)} scans): {np.median(n_lines):g}")
+
+
 def _reproduce(args: argparse.Namespace) -> None:
     import matplotlib
 
@@ -60,6 +78,10 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--truth", required=True, type=Path, help="output truth file")
     p.set_defaults(run=_simulate)
 
+    p = sub.add_parser("info", help="summarise a CARMEN log: scans, beams, lines per scan")
+    p.add_argument("log", type=Path, help="CARMEN text log (.clf)")
+    p.set_defaults(run=_info)
+
     p = sub.add_parser("reproduce", help="write the paper's figures as PNG files")
     p.add_argument("--out", default="figures", type=Path, help="output folder (default figures)")
     p.set_defaults(run=_reproduce)
@@ -81,7 +103,8 @@ def main(argv: list[str] | None = None) -> int:
         print(f"fhslam: error: no such file: {name}", file=sys.stderr)
         return EXIT_BAD_INPUT
     except (ValueError, OSError) as e:
-        print(f"fhslam: error: {e}", file=sys.stderr)
+        message = " ".join(str(e).split())  # one line, whatever the message
+        print(f"fhslam: error: {message}", file=sys.stderr)
         return EXIT_BAD_INPUT
     return 0
 

@@ -187,15 +187,25 @@ def test_invalid_params_raise(kw):
 # --------------------------------------------------------------------------- properties
 
 
-def _same_lines(a, b, end_tol=0.08):
-    """Same walls found: count equal; each line within 1 cm / 0.5°; n within 2 points; ends
-    within one beam step (8 cm, see test_endpoints_lie_on_the_wall_ends)."""
+def _same_lines(a, b, end_tol=0.16):
+    """Same walls found: count equal; each line has a partner within 1 cm / 0.5°, n within
+    3 points and ends within two beam steps (2 x 7.6 cm, see test_endpoints_lie_on_the_wall_ends):
+    the order in which a cluster's lines are found may change, and with it which line takes
+    a corner point lying within ``inlier_dist`` of both."""
     assert len(a) == len(b)
-    for la, lb in zip(a, b, strict=True):
-        drho, dth = line_difference(la.rho, la.theta, lb.rho, lb.theta)
+    for la in a:
+        diffs = [line_difference(la.rho, la.theta, lb.rho, lb.theta) for lb in b]
+        j = int(np.argmin([d[0] + d[1] for d in diffs]))
+        lb, (drho, dth) = b[j], diffs[j]
         assert drho < 0.01 and np.degrees(dth) < 0.5
-        assert abs(la.n - lb.n) <= 2
-        assert np.hypot(*(la.sp - lb.sp)) < end_tol and np.hypot(*(la.ep - lb.ep)) < end_tol
+        assert abs(la.n - lb.n) <= 3
+        ends = sorted(
+            [
+                np.hypot(*(la.sp - lb.sp)) + np.hypot(*(la.ep - lb.ep)),
+                np.hypot(*(la.sp - lb.ep)) + np.hypot(*(la.ep - lb.sp)),
+            ]
+        )[0]
+        assert ends < end_tol
 
 
 @settings(max_examples=40, deadline=None)
@@ -209,8 +219,9 @@ def test_extraction_is_invariant_under_a_rigid_motion(x, y, heading, motion):
     """Moving all points rigidly moves the extracted lines with them.
 
     Not bit-exact: the slope histogram's bins are fixed in the frame, so after a rotation the
-    refinement may start elsewhere and settle on another inlier set when a corner point lies
-    right at ``inlier_dist`` from a line (hypothesis found such a case: 121 vs 122 points).
+    refinement may start elsewhere, and the lines of one cluster may be found in another order,
+    so a corner point within ``inlier_dist`` of two lines may go to the other one
+    (hypothesis found such cases: 121 vs 122 points, one end 11.7 cm away).
     """
     p = room_points((x, y, heading))
     moved = extract_lines(transform_points(motion, p))

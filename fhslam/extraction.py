@@ -79,6 +79,10 @@ class ExtractionParams:
         Shortest segment reported, metres.
     max_lines_per_cluster : int
         Upper bound on the "sub-maximum" rounds per cluster.
+    max_peaks : int
+        Histogram peaks tried per round before a cluster is finished: when the best slope
+        holds no line with ``min_points`` support (its pairs straddled two walls), the next
+        peak outside its window is tried.
     seed : int
         Seed of the random pair sampling: the same seed gives the same lines.
     """
@@ -97,6 +101,7 @@ class ExtractionParams:
     min_points: int = 6
     min_length: float = 0.3
     max_lines_per_cluster: int = 12
+    max_peaks: int = 3
     seed: int = 0
 
     def __post_init__(self) -> None:
@@ -113,7 +118,12 @@ class ExtractionParams:
             )
         if self.min_points < 2:
             raise ValueError(f"ExtractionParams.min_points must be >= 2, got {self.min_points}")
-        if self.window_deg < 0 or self.n_pairs < 1 or self.refine_iterations < 0:
+        if (
+            self.window_deg < 0
+            or self.n_pairs < 1
+            or self.refine_iterations < 0
+            or self.max_peaks < 1
+        ):
             raise ValueError(
                 "ExtractionParams: window_deg, n_pairs, refine_iterations out of range"
             )
@@ -348,6 +358,7 @@ def _extract_kernel(
     min_points,
     min_length,
     max_rounds,
+    max_peaks,
 ):
     """The whole of Loop 1 for one scan.
 
@@ -379,25 +390,35 @@ def _extract_kernel(
                 if vp.shape[0] < 2:
                     break
                 hist = _slope_histogram_kernel(vp, u, n_bins, min_pair_dist, all_pairs)
-                phi, support = _dominant_kernel(hist)
-                if support <= 0:
-                    break
-                rho, theta = _window_hough_kernel(vp, phi, half, dtheta, rho_step)[:2]
-                # Inliers among the remaining scan points, refined by least squares.
-                for _it in range(refine_iterations + 1):
-                    _inliers(pts, rho, theta, tol, inl)
-                    inl &= alive
-                    if _it == refine_iterations:
-                        break
-                    r2, t2, k = _tls_kernel(pts, inl, theta)
-                    if k < 2 or np.isnan(r2):
-                        break
-                    rho, theta = r2, t2
+                # The maximum of the histogram, else its sub-maxima: a slope voted by pairs
+                # across two walls may hold no line while the next peak does.
                 n_inl = 0
-                for i in range(m):
-                    n_inl += inl[i]
+                for _peak in range(max_peaks):
+                    phi, support = _dominant_kernel(hist)
+                    if support <= 0:
+                        break
+                    rho, theta = _window_hough_kernel(vp, phi, half, dtheta, rho_step)[:2]
+                    # Inliers among the remaining scan points, refined by least squares.
+                    for _it in range(refine_iterations + 1):
+                        _inliers(pts, rho, theta, tol, inl)
+                        inl &= alive
+                        if _it == refine_iterations:
+                            break
+                        r2, t2, k = _tls_kernel(pts, inl, theta)
+                        if k < 2 or np.isnan(r2):
+                            break
+                        rho, theta = r2, t2
+                    n_inl = 0
+                    for i in range(m):
+                        n_inl += inl[i]
+                    if n_inl >= min_points:
+                        break
+                    k_peak = int(phi * n_bins / np.pi)  # suppress this peak and its window
+                    w_bins = max(1, int(np.ceil(half * dtheta * n_bins / np.pi)))
+                    for b in range(k_peak - w_bins, k_peak + w_bins + 1):
+                        hist[b % n_bins] = 0
                 if n_inl < min_points:
-                    break  # support under the threshold: this cluster is done
+                    break  # support under the threshold at every peak: this cluster is done
                 # Split the line's inliers at gaps; keep long-enough runs as segments.
                 run_start = -1
                 last = -1
@@ -750,6 +771,7 @@ def extract_lines(
         params.min_points,
         params.min_length,
         params.max_lines_per_cluster,
+        params.max_peaks,
     )
     n_in = np.diff(offsets)
     length = np.hypot(seg[:, 5] - seg[:, 3], seg[:, 6] - seg[:, 4])

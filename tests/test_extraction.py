@@ -187,11 +187,20 @@ def test_invalid_params_raise(kw):
 # --------------------------------------------------------------------------- properties
 
 
-def _same_lines(a, b, end_tol=0.16):
+def _end_spacing(points, line):
+    """Largest gap between scan neighbours around the line's two end points (metres)."""
+    i = np.r_[line.inliers[:3], line.inliers[-3:]]
+    j = np.clip(np.r_[i - 1, i], 0, len(points) - 2)
+    return np.hypot(*(points[j + 1] - points[j]).T).max()
+
+
+def _same_lines(points, a, b):
     """Same walls found: count equal; each line has a partner within 1 cm / 0.5°, n within
-    3 points and ends within two beam steps (2 x 7.6 cm, see test_endpoints_lie_on_the_wall_ends):
-    the order in which a cluster's lines are found may change, and with it which line takes
-    a corner point lying within ``inlier_dist`` of both."""
+    3 points, and each end within three point spacings at that end of the scan (plus 1 cm).
+
+    The order in which a cluster's lines are found may change, and with it which line takes
+    a corner point lying within ``inlier_dist`` of both; at a grazing corner one point step
+    along the wall is long (19 cm for a wall 1 m away seen at 17.7°)."""
     assert len(a) == len(b)
     for la in a:
         diffs = [line_difference(la.rho, la.theta, lb.rho, lb.theta) for lb in b]
@@ -199,16 +208,15 @@ def _same_lines(a, b, end_tol=0.16):
         lb, (drho, dth) = b[j], diffs[j]
         assert drho < 0.01 and np.degrees(dth) < 0.5
         assert abs(la.n - lb.n) <= 3
-        ends = sorted(
-            [
-                np.hypot(*(la.sp - lb.sp)) + np.hypot(*(la.ep - lb.ep)),
-                np.hypot(*(la.sp - lb.ep)) + np.hypot(*(la.ep - lb.sp)),
-            ]
-        )[0]
-        assert ends < end_tol
+        tol = 3 * _end_spacing(points, la) + 0.01
+        ends = min(
+            max(np.hypot(*(la.sp - lb.sp)), np.hypot(*(la.ep - lb.ep))),
+            max(np.hypot(*(la.sp - lb.ep)), np.hypot(*(la.ep - lb.sp))),
+        )
+        assert ends < tol
 
 
-@settings(max_examples=40, deadline=None)
+@settings(max_examples=100, deadline=None, derandomize=True)
 @given(
     x=st.floats(1.0, 5.0),
     y=st.floats(1.0, 3.0),
@@ -226,10 +234,10 @@ def test_extraction_is_invariant_under_a_rigid_motion(x, y, heading, motion):
     p = room_points((x, y, heading))
     moved = extract_lines(transform_points(motion, p))
     back = [ln.transformed(inverse(motion)) for ln in moved]
-    _same_lines(extract_lines(p), back)
+    _same_lines(p, extract_lines(p), back)
 
 
-@settings(max_examples=15, deadline=None)
+@settings(max_examples=15, deadline=None, derandomize=True)
 @given(seed=st.integers(0, 2**31 - 1), x=st.floats(1.0, 5.0), heading=st.floats(-3, 3))
 def test_same_seed_gives_the_same_lines(seed, x, heading):
     p = room_points((x, 2.0, heading), seed=seed % 1000)

@@ -303,6 +303,16 @@ def rasterise(
     return image, origin
 
 
+def _rasterised_input(points: ArrayLike, params: ClassicalHoughParams | None):
+    """Validated points, params and the scan drawn as an image (None for < 2 points)."""
+    p = as_points(points)
+    params = params or ClassicalHoughParams()
+    if len(p) < 2:
+        return p, params, None, None
+    image, origin = rasterise(p, params.pixel)
+    return p, params, image, origin
+
+
 def hough_opencv_raster(
     points: ArrayLike, params: ClassicalHoughParams | None = None, pose: ArrayLike | None = None
 ) -> list[Line]:
@@ -314,11 +324,9 @@ def hough_opencv_raster(
 
     Parameters and returns as :func:`hough_numpy_accumulator`.
     """
-    p = as_points(points)
-    params = params or ClassicalHoughParams()
-    if len(p) < 2:
+    p, params, image, origin = _rasterised_input(points, params)
+    if image is None:
         return []
-    image, origin = rasterise(p, params.pixel)
     found = cv2.HoughLines(
         image, params.rho_step / params.pixel, params.theta_step, params.vote_threshold - 1
     )
@@ -340,11 +348,9 @@ def hough_opencv_probabilistic(
 
     Parameters and returns as :func:`hough_numpy_accumulator`.
     """
-    p = as_points(points)
-    params = params or ClassicalHoughParams()
-    if len(p) < 2:
+    p, params, image, origin = _rasterised_input(points, params)
+    if image is None:
         return []
-    image, origin = rasterise(p, params.pixel)
     found = cv2.HoughLinesP(
         image,
         params.rho_step / params.pixel,

@@ -29,7 +29,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from fhslam.geometry import relative, wrap_angle
-from fhslam.io.log import Log
+from fhslam.io.log import Log, is_number
 
 HOSTNAME = "fhslam"
 DEFAULT_MAX_RANGE = 8.0
@@ -156,14 +156,6 @@ def _count(token: str, what: str, where: str) -> int:
     return value
 
 
-def _is_number(token: str) -> bool:
-    try:
-        float(token)
-    except ValueError:
-        return False
-    return True
-
-
 def _check_finite(values: NDArray[np.float64], what: str, where: str) -> None:
     if not np.all(np.isfinite(values)):
         raise CarmenFormatError(f"{where}: non-finite {what} {values.tolist()}")
@@ -177,7 +169,7 @@ def _parse_flaser(fields: list[str], where: str) -> tuple[float, NDArray, NDArra
     expected = n + 11
     if len(fields) != expected:
         # A complete line ends with "... ipc_timestamp hostname logger_timestamp".
-        complete = len(fields) >= 11 and not _is_number(fields[-2])
+        complete = len(fields) >= 11 and not is_number(fields[-2])
         if complete:
             raise CarmenFormatError(
                 f"{where}: wrong reading count: FLASER num_readings is {n} but the line "

@@ -104,3 +104,12 @@ class Log:
             f"Log({self.name!r}: {len(self)} scans x {self.n_beams} beams, {duration:.1f} s, "
             f"max_range={self.max_range:g} m{', with ' + ' and '.join(extras) if extras else ''})"
         )
+
+
+def is_number(token: str) -> bool:
+    """Whether a text field of a log or trajectory file parses as a float."""
+    try:
+        float(token)
+    except ValueError:
+        return False
+    return True

@@ -14,6 +14,8 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from fhslam.io.log import is_number
+
 
 class TrajectoryFormatError(ValueError):
     """A malformed trajectory file. The message reads ``"{path}:{lineno}: {what is wrong}"``."""
@@ -95,7 +97,7 @@ def read_trajectory(path: str | PathLike[str]) -> tuple[NDArray[np.float64], NDA
                 try:
                     row = [float(v) for v in fields]
                 except ValueError:
-                    bad = next(v for v in fields if not _is_number(v))
+                    bad = next(v for v in fields if not is_number(v))
                     raise TrajectoryFormatError(f"{where}: non-numeric value {bad!r}") from None
                 if not all(np.isfinite(row)):
                     raise TrajectoryFormatError(f"{where}: non-finite value in {fields}")
@@ -106,11 +108,3 @@ def read_trajectory(path: str | PathLike[str]) -> tuple[NDArray[np.float64], NDA
         raise TrajectoryFormatError(f"{path}: no poses found")
     a = np.array(rows)
     return a[:, 0], a[:, 1:]
-
-
-def _is_number(token: str) -> bool:
-    try:
-        float(token)
-    except ValueError:
-        return False
-    return True

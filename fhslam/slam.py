@@ -1,0 +1,296 @@
+"""Loop 3 of the paper: step-by-step self-calibration and map building (FH-SLAM).
+
+Paper, "Self calibration and map building" and the simulation's step list:
+
+1. receive the scan and the odometry; predict the pose from the odometry increment;
+2. extract the scan's lines (Loop 1) and place them in the world at the predicted pose;
+3. if there are no reference lines yet, the (longer) lines become the reference lines;
+4. otherwise match them to the reference lines (Loop 2), compute the pose error from the
+   matched pairs and calibrate the robot's pose (:func:`calibrate_pose`);
+5. re-place the lines with the calibrated pose, merge the matched ones into their reference
+   lines (Fig. 11) and add new long lines as reference lines;
+6. the map is the list of reference lines.
+
+A step without a scan (dropped), without lines or without a match keeps the odometry
+prediction. Where the matched lines do not constrain a direction (a corridor: all lines
+parallel) the pose is not corrected along it (see :func:`calibrate_pose`).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+from tqdm.auto import tqdm
+
+from fhslam.extraction import ExtractionParams, extract_lines, scan_to_points
+from fhslam.geometry import as_pose, compose, relative, wrap_angle
+from fhslam.lines import Line
+from fhslam.matching import MatchParams, match_lines, merge
+
+
+@dataclass(frozen=True)
+class SlamParams:
+    """Parameters of FH-SLAM's Loop 3 (and the loops it calls).
+
+    Attributes
+    ----------
+    extraction : ExtractionParams
+        Loop 1.
+    matching : MatchParams
+        Loop 2, used to associate new lines with reference lines.
+    min_reference_length : float
+        New lines at least this long (metres) become reference lines ("generally speaking
+        we choose one or several longer straight lines").
+    min_reference_points : int
+        ... and supported by at least this many scan points.
+    iterations : int
+        Rounds of "match, compute the pose error, correct" per step.
+    min_eigen_ratio : float
+        A direction is constrained by the matched lines only when the information in it is
+        at least this fraction of the strongest direction's (corridor test).
+    max_correction : float
+        Largest accepted pose correction per step, metres; a bigger one is taken as a wrong
+        association and the odometry prediction is kept.
+    max_rotation_deg : float
+        Largest accepted heading correction per step, degrees.
+    """
+
+    extraction: ExtractionParams = ExtractionParams()
+    matching: MatchParams = MatchParams()
+    min_reference_length: float = 0.6
+    min_reference_points: int = 10
+    iterations: int = 3
+    min_eigen_ratio: float = 0.05
+    max_correction: float = 0.5
+    max_rotation_deg: float = 10.0
+
+
+@dataclass(frozen=True)
+class Calibration:
+    """Result of :func:`calibrate_pose`."""
+
+    pose: NDArray[np.float64]
+    correction: NDArray[np.float64]
+    constrained: tuple[bool, bool]
+    n_pairs: int
+
+
+def _world_lines(observed: Sequence[Line], pose: NDArray) -> list[Line]:
+    return [ln.transformed(pose) for ln in observed]
+
+
+def calibrate_pose(
+    observed: Sequence[Line],
+    references: Sequence[Line],
+    pairs: Sequence[tuple[int, int]],
+    pose: ArrayLike,
+    iterations: int = 3,
+    min_eigen_ratio: float = 0.05,
+) -> Calibration:
+    """The robot pose that best lays the observed lines onto their reference lines.
+
+    "Compute the deviation angle and distance between the new detecting line segment and the
+    corresponding referenced one and calibrate the robot's pose." The deviation of a pair is
+    measured where it is seen: the signed distances of the observed segment's two endpoints
+    (placed in the world at the current pose) to the reference line. The pose correction
+    ``(dx, dy, dtheta)``, rotating about the robot, minimises their support-weighted squares
+    (Gauss-Newton, ``iterations`` rounds). Distances measured this way do not depend on where
+    the world origin lies, unlike differences of the lines' Hessian ``rho``.
+
+    Along an eigen-direction of the 3 x 3 normal matrix whose information is under
+    ``min_eigen_ratio`` of the largest (all matched lines parallel: a corridor), the pose is
+    not corrected: the odometry is kept there rather than a correction invented.
+
+    Parameters
+    ----------
+    observed : sequence of Line
+        Lines in the robot frame.
+    references : sequence of Line
+        Reference lines in the world frame.
+    pairs : sequence of (int, int)
+        ``(observed index, reference index)`` of the matched lines.
+    pose : array-like, shape (3,)
+        The predicted pose ``world_T_robot``.
+
+    Returns
+    -------
+    Calibration
+        The calibrated pose, the correction applied ``(dx, dy, dtheta)``, whether the
+        position is constrained along its weakest / strongest directions, and the number of
+        pairs.
+    """
+    pose0 = as_pose(pose)
+    x = pose0.copy()
+    if not pairs:
+        return Calibration(x, np.zeros(3), (False, False), 0)
+    obs = [observed[i] for i, _ in pairs]
+    refs = [references[j] for _, j in pairs]
+    # Each pair contributes its two endpoints; robot-frame points (2P, 2).
+    q = np.array([[o.sp, o.ep] for o in obs]).reshape(-1, 2)
+    th_r = np.repeat([r.theta for r in refs], 2)
+    rho_r = np.repeat([r.rho for r in refs], 2)
+    n_r = np.column_stack([np.cos(th_r), np.sin(th_r)])
+    w = np.repeat([min(o.n, r.n) for o, r in zip(obs, refs, strict=True)], 2).astype(float)
+    constrained = (False, False)
+    for _ in range(iterations):
+        c, s_ = np.cos(x[2]), np.sin(x[2])
+        rel = q @ np.array([[c, s_], [-s_, c]])  # rotated into the world, relative to robot
+        p_w = rel + x[:2]
+        r = rho_r - np.einsum("ij,ij->i", n_r, p_w)  # signed distance to the reference
+        jac = np.column_stack([n_r, n_r[:, 1] * rel[:, 0] - n_r[:, 0] * rel[:, 1]])
+        h = (jac * w[:, None]).T @ jac
+        g = (jac * w[:, None]).T @ r
+        evals, evecs = np.linalg.eigh(h)
+        ok = evals > min_eigen_ratio * max(evals[-1], 1e-12)
+        delta = sum((evecs[:, k] @ g / evals[k]) * evecs[:, k] for k in range(3) if ok[k])
+        x = x + delta
+        x[2] = wrap_angle(x[2])
+        h_xy = np.linalg.eigvalsh(h[:2, :2])
+        constrained = (bool(h_xy[0] > min_eigen_ratio * h_xy[1]), bool(h_xy[1] > 0))
+    correction = x - pose0
+    correction[2] = wrap_angle(correction[2])
+    return Calibration(x, correction, constrained, len(pairs))
+
+
+@dataclass
+class StepResult:
+    """What one SLAM step did."""
+
+    pose: NDArray[np.float64]
+    n_lines: int
+    n_matched: int
+    n_added: int
+    corrected: bool
+
+
+@dataclass
+class SlamResult:
+    """A whole run: one pose per scan, and the map."""
+
+    timestamps: NDArray[np.float64]
+    poses: NDArray[np.float64]
+    map: list[Line]
+    steps: list[StepResult] = field(repr=False)
+
+
+class FastHoughSLAM:
+    """The paper's step-by-step SLAM: fast Hough lines, four-condition matching, pose
+    calibration from matched lines, merging into a map of reference lines.
+
+    Parameters
+    ----------
+    params : SlamParams, optional
+    initial_pose : array-like, shape (3,), optional
+        The known pose of the first scan ("suppose the initial localization of mobile robot
+        is correct"); default: the first odometry pose.
+
+    Examples
+    --------
+    >>> slam = FastHoughSLAM()
+    >>> for ranges, odo in zip(log.ranges, log.odometry):       # doctest: +SKIP
+    ...     slam.step(ranges, log.angles, odo, max_range=log.max_range)
+    >>> slam.references                                           # doctest: +SKIP
+    """
+
+    def __init__(self, params: SlamParams | None = None, initial_pose: ArrayLike | None = None):
+        self.params = params or SlamParams()
+        self.references: list[Line] = []
+        self.pose: NDArray[np.float64] | None = (
+            None if initial_pose is None else as_pose(initial_pose, "initial_pose")
+        )
+        self._last_odometry: NDArray[np.float64] | None = None
+
+    def predict(self, odometry: ArrayLike) -> NDArray[np.float64]:
+        """Move the pose estimate by the odometry increment since the last step."""
+        odo = as_pose(odometry, "odometry")
+        if self.pose is None:
+            self.pose = odo.copy()
+        elif self._last_odometry is not None:
+            self.pose = compose(self.pose, relative(self._last_odometry, odo))
+        self._last_odometry = odo
+        return self.pose
+
+    def step(
+        self,
+        ranges: ArrayLike | None,
+        angles: ArrayLike | None,
+        odometry: ArrayLike,
+        max_range: float | None = None,
+    ) -> StepResult:
+        """One step of the paper's procedure; ``ranges=None`` is a dropped scan."""
+        p = self.params
+        pose = self.predict(odometry)
+        if ranges is None:
+            return StepResult(pose.copy(), 0, 0, 0, False)
+        points, _ = scan_to_points(ranges, angles, max_range=max_range)
+        observed = extract_lines(points, p.extraction)
+        if not self.references:
+            added = self._add_references(observed, pose, np.full(len(observed), -1))
+            return StepResult(pose.copy(), len(observed), 0, added, False)
+        corrected = False
+        match = np.full(len(observed), -1)
+        for _ in range(2):  # associate at the prediction, calibrate, re-associate
+            match = match_lines(_world_lines(observed, pose), self.references, p.matching, pose)
+            pairs = [(i, int(j)) for i, j in enumerate(match) if j >= 0]
+            cal = calibrate_pose(
+                observed, self.references, pairs, pose, p.iterations, p.min_eigen_ratio
+            )
+            if (
+                np.hypot(*cal.correction[:2]) > p.max_correction
+                or abs(np.degrees(cal.correction[2])) > p.max_rotation_deg
+            ):
+                break  # implausible: a wrong association; keep the prediction
+            corrected = corrected or cal.n_pairs > 0
+            pose = cal.pose
+        self.pose = pose
+        match = match_lines(_world_lines(observed, pose), self.references, p.matching, pose)
+        world = _world_lines(observed, pose)
+        for ln, j in zip(world, match, strict=True):
+            if j >= 0:
+                self.references[j] = merge(self.references[j], ln)
+        added = self._add_references(observed, pose, match)
+        n_matched = int((match >= 0).sum())
+        return StepResult(pose.copy(), len(observed), n_matched, added, corrected)
+
+    def _add_references(self, observed: Sequence[Line], pose: NDArray, match: NDArray) -> int:
+        p = self.params
+        new = [
+            ln.transformed(pose)
+            for ln, j in zip(observed, match, strict=True)
+            if j < 0 and ln.length >= p.min_reference_length and ln.n >= p.min_reference_points
+        ]
+        self.references.extend(new)
+        return len(new)
+
+    def run(self, log, progress: bool = False) -> SlamResult:
+        """Run over a whole log (any object with ``timestamps``, ``ranges``, ``angles``,
+        ``odometry`` and ``max_range``); scans whose ranges are all NaN count as dropped."""
+        steps = []
+        it = range(len(log.timestamps))
+        for k in tqdm(
+            it, desc=f"FH-SLAM {getattr(log, 'name', '')}", unit="scan", disable=not progress
+        ):
+            steps.append(self.step(log.ranges[k], log.angles, log.odometry[k], log.max_range))
+        poses = np.array([s.pose for s in steps]).reshape(-1, 3)
+        return SlamResult(
+            np.asarray(log.timestamps, dtype=float), poses, list(self.references), steps
+        )
+
+
+def run_slam(
+    log, method: str = "fht", params: SlamParams | None = None, progress: bool = False
+) -> SlamResult:
+    """Run a SLAM method on a log: ``"fht"`` (FH-SLAM) or ``"odometry"`` (dead reckoning).
+
+    FH-SLAM starts at the first odometry pose, which a simulated log sets to the true start.
+    """
+    if method == "odometry":
+        return SlamResult(
+            np.asarray(log.timestamps, float), np.asarray(log.odometry, float), [], []
+        )
+    if method == "fht":
+        return FastHoughSLAM(params).run(log, progress=progress)
+    raise ValueError(f"unknown SLAM method {method!r}; choose 'fht' or 'odometry'")

@@ -58,8 +58,8 @@ class SlamParams:
         Largest accepted heading correction per step, degrees.
     """
 
-    extraction: ExtractionParams = ExtractionParams()
-    matching: MatchParams = MatchParams()
+    extraction: ExtractionParams = field(default_factory=ExtractionParams)
+    matching: MatchParams = field(default_factory=MatchParams)
     min_reference_length: float = 0.6
     min_reference_points: int = 10
     iterations: int = 3
@@ -142,14 +142,22 @@ def calibrate_pose(
         r = rho_r - np.einsum("ij,ij->i", n_r, p_w)  # signed distance to the reference
         jac = np.column_stack([n_r, n_r[:, 1] * rel[:, 0] - n_r[:, 0] * rel[:, 1]])
         h = (jac * w[:, None]).T @ jac
-        g = (jac * w[:, None]).T @ r
-        evals, evecs = np.linalg.eigh(h)
-        ok = evals > min_eigen_ratio * max(evals[-1], 1e-12)
-        delta = sum((evecs[:, k] @ g / evals[k]) * evecs[:, k] for k in range(3) if ok[k])
+        # Position information left once the heading is free (Schur complement): its
+        # weak eigen-direction, if any, is the corridor's axis.
+        schur = h[:2, :2] - np.outer(h[:2, 2], h[2, :2]) / max(h[2, 2], 1e-12)
+        evals, evecs = np.linalg.eigh(schur)
+        ok = evals > min_eigen_ratio * max(evals[1], 1e-12)
+        constrained = (bool(ok[0]), bool(ok[1]))
+        basis = np.zeros((3, int(ok.sum()) + 1))  # constrained position directions + heading
+        basis[:2, :-1] = evecs[:, ok]
+        basis[2, -1] = 1.0
+        jr = jac @ basis
+        delta = (
+            basis
+            @ np.linalg.lstsq((jr * w[:, None]).T @ jr, (jr * w[:, None]).T @ r, rcond=None)[0]
+        )
         x = x + delta
         x[2] = wrap_angle(x[2])
-        h_xy = np.linalg.eigvalsh(h[:2, :2])
-        constrained = (bool(h_xy[0] > min_eigen_ratio * h_xy[1]), bool(h_xy[1] > 0))
     correction = x - pose0
     correction[2] = wrap_angle(correction[2])
     return Calibration(x, correction, constrained, len(pairs))

@@ -49,3 +49,18 @@ def real_data() -> Path:
     if d is None:
         pytest.skip("no real laser logs: set FHSLAM_DATA or place them in ../shared/data")
     return d
+
+
+@pytest.fixture(scope="session")
+def paper_log_perfect():
+    """The paper world driven with perfect odometry (seed 0)."""
+    from fhslam.sim import OdometryNoise, paper_world, simulate
+
+    return simulate(paper_world(), seed=0, odometry=OdometryNoise.none())
+
+
+@pytest.fixture(scope="session")
+def paper_log_small():
+    from fhslam.sim import paper_world, simulate
+
+    return simulate(paper_world(), seed=0, max_scans=20)

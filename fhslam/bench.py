@@ -119,6 +119,35 @@ def run_bench(
     return rows
 
 
+@dataclass(frozen=True)
+class SlamBenchRow:
+    method: str
+    steps_per_second: float
+    seconds: float
+    n_steps: int
+
+
+def run_slam_bench(world: str = "paper", seed: int = 0, repeats: int = 3) -> list[SlamBenchRow]:
+    """SLAM steps per second on one simulated run (median wall time over ``repeats`` runs)."""
+    from fhslam.slam import run_slam
+
+    log = simulate(load_world(world), seed=seed)
+    rows = []
+    for method in ("fht", "odometry"):
+        run_slam(log, method)  # warm-up (JIT, caches)
+        t = _median_time(lambda m=method: run_slam(log, m), repeats)
+        rows.append(SlamBenchRow(method, len(log) / t, t, len(log)))
+    return rows
+
+
+def format_slam_table(rows: Sequence[SlamBenchRow]) -> str:
+    head = f"{'SLAM method':<14} {'steps/s':>10} {'s per run':>10} {'steps':>7}"
+    lines = [head, "-" * len(head)]
+    for r in rows:
+        lines.append(f"{r.method:<14} {r.steps_per_second:10.0f} {r.seconds:10.3f} {r.n_steps:7d}")
+    return "\n".join(lines)
+
+
 def format_table(rows: Sequence[BenchRow]) -> str:
     """The bench result as a plain-text table."""
     head = (

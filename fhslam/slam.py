@@ -27,7 +27,7 @@ from tqdm.auto import tqdm
 
 from fhslam.extraction import ExtractionParams, extract_lines, scan_to_points
 from fhslam.geometry import as_pose, compose, relative, wrap_angle
-from fhslam.lines import Line
+from fhslam.lines import Line, transform_lines
 from fhslam.matching import MatchParams, match_lines, merge
 
 
@@ -76,10 +76,6 @@ class Calibration:
     correction: NDArray[np.float64]
     constrained: tuple[bool, bool]
     n_pairs: int
-
-
-def _world_lines(observed: Sequence[Line], pose: NDArray) -> list[Line]:
-    return [ln.transformed(pose) for ln in observed]
 
 
 def calibrate_pose(
@@ -239,9 +235,9 @@ class FastHoughSLAM:
             added = self._add_references(observed, pose, np.full(len(observed), -1))
             return StepResult(pose.copy(), len(observed), 0, added, False)
         corrected = False
-        match = np.full(len(observed), -1)
+        world = transform_lines(observed, pose)
         for _ in range(2):  # associate at the prediction, calibrate, re-associate
-            match = match_lines(_world_lines(observed, pose), self.references, p.matching, pose)
+            match = match_lines(world, self.references, p.matching, pose)
             pairs = [(i, int(j)) for i, j in enumerate(match) if j >= 0]
             cal = calibrate_pose(
                 observed, self.references, pairs, pose, p.iterations, p.min_eigen_ratio
@@ -253,9 +249,10 @@ class FastHoughSLAM:
                 break  # implausible: a wrong association; keep the prediction
             corrected = corrected or cal.n_pairs > 0
             pose = cal.pose
+            world = transform_lines(observed, pose)
         self.pose = pose
-        match = match_lines(_world_lines(observed, pose), self.references, p.matching, pose)
-        world = _world_lines(observed, pose)
+        # Re-place the lines with the calibrated pose; merge the matched ones into the map.
+        match = match_lines(world, self.references, p.matching, pose)
         for ln, j in zip(world, match, strict=True):
             if j >= 0:
                 self.references[j] = merge(self.references[j], ln)
@@ -265,11 +262,14 @@ class FastHoughSLAM:
 
     def _add_references(self, observed: Sequence[Line], pose: NDArray, match: NDArray) -> int:
         p = self.params
-        new = [
-            ln.transformed(pose)
-            for ln, j in zip(observed, match, strict=True)
-            if j < 0 and ln.length >= p.min_reference_length and ln.n >= p.min_reference_points
-        ]
+        new = transform_lines(
+            [
+                ln
+                for ln, j in zip(observed, match, strict=True)
+                if j < 0 and ln.length >= p.min_reference_length and ln.n >= p.min_reference_points
+            ],
+            pose,
+        )
         self.references.extend(new)
         return len(new)
 

@@ -49,7 +49,7 @@ def test_calibration_recovers_a_known_pose_offset(dx, dy, dth, x, y, th):
 
 def test_corridor_keeps_odometry_along_it():
     truth = np.array([5.0, 1.0, 0.0])
-    predicted = truth + [0.4, 0.1, 0.02]  # 40 cm wrong along the corridor
+    predicted = truth + np.array([0.4, 0.1, 0.02])  # 40 cm wrong along the corridor
     cal = calibrate_pose(observe(CORRIDOR, truth), CORRIDOR, [(0, 0), (1, 1)], predicted)
     assert cal.pose[1] == pytest.approx(1.0, abs=1e-3)  # across: corrected
     assert cal.pose[2] == pytest.approx(0.0, abs=1e-4)  # heading: corrected

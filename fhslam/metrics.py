@@ -1,4 +1,11 @@
-"""Measurement: line-detection scores against the simulator's true walls.
+"""Measurement: line-detection scores, trajectory errors (ATE, RPE) and map errors.
+
+Line detection (against the simulator's true walls) comes first; the trajectory metrics
+(:func:`ate`, :func:`rpe`, after evo) and map metrics (:func:`map_error`,
+:func:`map_coverage`) follow.
+
+Line-detection scores
+---------------------
 
 After Nguyen, Gächter, Martinelli, Tomatis and Siegwart, "A comparison of line extraction
 algorithms using 2D laser rangefinder for indoor mobile robotics", IROS 2005, Table II:
@@ -27,7 +34,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from fhslam.extraction import scan_to_points
-from fhslam.geometry import inverse, line_through, transform_points
+from fhslam.geometry import inverse, line_through, relative, transform_points, wrap_angle
 from fhslam.lines import Line
 
 
@@ -248,3 +255,518 @@ def score_extractor(
             yield extract(pts), beams, truth, rob
 
     return detection_scores(per_scan(), **match_kwargs)
+
+
+# ==========================================================================================
+# Trajectory metrics: absolute and relative pose error (after evo, github.com/MichaelGrupp/evo)
+# ==========================================================================================
+#
+# Names and definitions follow evo (Grupp, "evo: Python package for the evaluation of
+# odometry and SLAM", 2017): APE/ATE is the per-pose translation error, RPE the error of the
+# relative motion between two poses, each summarised by rmse, mean, median, std, min, max.
+
+
+@dataclass(frozen=True)
+class ErrorStats:
+    """Summary statistics of a set of errors, as evo reports them.
+
+    Attributes
+    ----------
+    rmse : float
+        ``sqrt(mean(e**2))``.
+    mean, median : float
+    std : float
+        Population standard deviation (``numpy.std``, ``ddof=0``), as evo.
+    min, max : float
+    """
+
+    rmse: float
+    mean: float
+    median: float
+    std: float
+    min: float
+    max: float
+
+    def as_dict(self) -> dict[str, float]:
+        """``{"rmse": ..., "mean": ..., "median": ..., "std": ..., "min": ..., "max": ...}``."""
+        return dict(self.__dict__)
+
+
+def error_stats(errors: ArrayLike) -> ErrorStats:
+    """Summarise errors by rmse, mean, median, std (population), min and max.
+
+    Parameters
+    ----------
+    errors : array-like, shape (N,), N >= 1
+        Finite error values (e.g. metres or degrees).
+
+    Raises
+    ------
+    ValueError
+        For no errors or a non-finite one.
+    """
+    e = np.asarray(errors, dtype=float).ravel()
+    if e.size == 0:
+        raise ValueError("error_stats needs at least one error value, got none")
+    if not np.all(np.isfinite(e)):
+        raise ValueError(f"error_stats got {int((~np.isfinite(e)).sum())} non-finite errors")
+    return ErrorStats(
+        rmse=float(np.sqrt(np.mean(e * e))),
+        mean=float(np.mean(e)),
+        median=float(np.median(e)),
+        std=float(np.std(e)),
+        min=float(np.min(e)),
+        max=float(np.max(e)),
+    )
+
+
+def _stamps(t: ArrayLike, name: str) -> NDArray[np.float64]:
+    a = np.asarray(t, dtype=float)
+    if a.ndim != 1:
+        raise ValueError(f"{name} must have shape (N,), got {a.shape}")
+    if not np.all(np.isfinite(a)):
+        raise ValueError(f"{name} must be finite")
+    return a
+
+
+def _nearest(query: NDArray[np.float64], stamps: NDArray[np.float64]) -> NDArray[np.intp]:
+    """Index into ``stamps`` (any order) of the stamp nearest to each query, shape (Q,)."""
+    order = np.argsort(stamps, kind="stable")
+    s = stamps[order]
+    pos = np.searchsorted(s, query)
+    lo = np.clip(pos - 1, 0, len(s) - 1)
+    hi = np.clip(pos, 0, len(s) - 1)
+    take_hi = np.abs(s[hi] - query) < np.abs(s[lo] - query)
+    return order[np.where(take_hi, hi, lo)]
+
+
+def associate(
+    t_est: ArrayLike, t_ref: ArrayLike, max_diff: float = 0.01
+) -> tuple[NDArray[np.intp], NDArray[np.intp]]:
+    """Pair poses of two trajectories by timestamp, like evo's ``associate_trajectories``.
+
+    Every stamp of the *shorter* trajectory (the reference on a tie) is paired with the
+    nearest stamp of the other one, and the pair is kept if they differ by at most
+    ``max_diff`` seconds. As in evo, a stamp of the longer trajectory may be used twice when
+    the shorter one is sampled more densely than ``max_diff``.
+
+    Parameters
+    ----------
+    t_est, t_ref : array-like, shape (N,) and (M,)
+        Timestamps in seconds (any order).
+    max_diff : float
+        Largest accepted time difference, seconds (evo's default 0.01 s).
+
+    Returns
+    -------
+    i_est, i_ref : ndarray of int, shape (K,)
+        Indices of the matched poses, ``t_est[i_est[k]] ~ t_ref[i_ref[k]]``, in the order of
+        the shorter trajectory.
+    """
+    te, tr = _stamps(t_est, "t_est"), _stamps(t_ref, "t_ref")
+    if not max_diff >= 0:
+        raise ValueError(f"max_diff must be >= 0 seconds, got {max_diff}")
+    if len(te) == 0 or len(tr) == 0:
+        return np.zeros(0, dtype=np.intp), np.zeros(0, dtype=np.intp)
+    if len(tr) > len(te):  # iterate over the shorter one, as evo does
+        i_est = np.arange(len(te), dtype=np.intp)
+        i_ref = _nearest(te, tr)
+    else:
+        i_ref = np.arange(len(tr), dtype=np.intp)
+        i_est = _nearest(tr, te)
+    keep = np.abs(te[i_est] - tr[i_ref]) <= max_diff
+    return i_est[keep], i_ref[keep]
+
+
+def _poses(p: ArrayLike, name: str, cols: tuple[int, ...] = (3,)) -> NDArray[np.float64]:
+    a = np.asarray(p, dtype=float)
+    if a.ndim != 2 or a.shape[1] not in cols:
+        shapes = " or ".join(f"(N, {c})" for c in cols)
+        raise ValueError(f"{name} must have shape {shapes}, got {a.shape}")
+    if not np.all(np.isfinite(a)):
+        raise ValueError(f"{name} must be finite")
+    return a
+
+
+def _pair(est: ArrayLike, ref: ArrayLike, cols: tuple[int, ...]) -> tuple[NDArray, NDArray]:
+    e, r = _poses(est, "est_poses", cols), _poses(ref, "ref_poses", cols)
+    if len(e) != len(r):
+        raise ValueError(
+            f"est_poses and ref_poses must be associated pose by pose (fhslam.metrics."
+            f"associate), got {len(e)} and {len(r)} poses"
+        )
+    if len(e) == 0:
+        raise ValueError("no poses to compare")
+    return e, r
+
+
+def align_se2(src: ArrayLike, dst: ArrayLike) -> NDArray[np.float64]:
+    """Rigid SE(2) least-squares alignment of point sets (Umeyama 1991 without scale).
+
+    Finds the rotation ``R(theta)`` and translation ``t`` minimising
+    ``sum_i |dst_i - (R src_i + t)|**2``. In 2D Umeyama's SVD solution has the closed form
+    ``theta = atan2(sum cross(a_i, b_i), sum dot(a_i, b_i))`` for the centred points
+    ``a = src - mean(src)``, ``b = dst - mean(dst)`` (a proper rotation, never a reflection),
+    and ``t = mean(dst) - R mean(src)``.
+
+    Parameters
+    ----------
+    src, dst : array-like, shape (N, 2) or (N, 3)
+        Corresponding positions (only x, y are used), e.g. estimated and true poses.
+
+    Returns
+    -------
+    ndarray, shape (3,)
+        The transform as a pose ``(x, y, theta)``: ``transform_points(T, src) ~ dst``.
+        With all ``src`` points identical the rotation is undetermined and 0 is returned.
+    """
+    s, d = _pair(src, dst, (2, 3))
+    s, d = s[:, :2], d[:, :2]
+    ms, md = s.mean(axis=0), d.mean(axis=0)
+    a, b = s - ms, d - md
+    theta = float(
+        np.arctan2(
+            np.sum(a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]),
+            np.sum(a[:, 0] * b[:, 0] + a[:, 1] * b[:, 1]),
+        )
+    )
+    c, sn = np.cos(theta), np.sin(theta)
+    t = md - np.array([c * ms[0] - sn * ms[1], sn * ms[0] + c * ms[1]])
+    return np.array([t[0], t[1], theta])
+
+
+def ate_errors(est_poses: ArrayLike, ref_poses: ArrayLike, align: bool = False) -> NDArray:
+    """Per-pose translation error ``|p_est - p_ref|`` (evo's APE, translation part), metres.
+
+    Parameters
+    ----------
+    est_poses, ref_poses : array-like, shape (N, 3) or (N, 2)
+        Associated poses (see :func:`associate`); only x, y are used.
+    align : bool
+        First move the estimate rigidly onto the reference (:func:`align_se2`).
+
+    Returns
+    -------
+    ndarray, shape (N,)
+    """
+    e, r = _pair(est_poses, ref_poses, (2, 3))
+    p = e[:, :2]
+    if align:
+        p = transform_points(align_se2(p, r), p)
+    return np.hypot(*(p - r[:, :2]).T)
+
+
+def ate(est_poses: ArrayLike, ref_poses: ArrayLike, align: bool = False) -> ErrorStats:
+    """Absolute trajectory error (evo's APE, translation part), metres.
+
+    By default **no alignment**: the SLAM starts at the known first true pose, so its map
+    frame is the world frame and any offset is a real error (evo ``evo_ape`` without ``-a``).
+    ``align=True`` first applies the SE(2) least-squares alignment (Umeyama without scale,
+    evo ``-a``), which measures only the shape of the trajectory.
+
+    Parameters
+    ----------
+    est_poses, ref_poses : array-like, shape (N, 3) or (N, 2)
+        Associated estimated and true poses (see :func:`associate`).
+    align : bool
+
+    Returns
+    -------
+    ErrorStats
+    """
+    return error_stats(ate_errors(est_poses, ref_poses, align=align))
+
+
+def rpe_pairs(n: int, delta: int = 1, all_pairs: bool = False) -> NDArray[np.intp]:
+    """Index pairs ``(i, j)`` ``delta`` frames apart, as evo's ``filter_pairs_by_index``.
+
+    Parameters
+    ----------
+    n : int
+        Number of poses.
+    delta : int
+        Frame distance, >= 1.
+    all_pairs : bool
+        False (evo's default): consecutive, non-overlapping pairs ``(0, d), (d, 2d), ...``;
+        True: every ``(i, i + d)``.
+
+    Returns
+    -------
+    ndarray of int, shape (K, 2)
+    """
+    if int(delta) != delta or delta < 1:
+        raise ValueError(f"delta must be an integer >= 1 (frames), got {delta}")
+    delta = int(delta)
+    if all_pairs:
+        i = np.arange(max(n - delta, 0), dtype=np.intp)
+        return np.column_stack([i, i + delta])
+    ids = np.arange(0, n, delta, dtype=np.intp)
+    return np.column_stack([ids[:-1], ids[1:]])
+
+
+def rpe_errors(
+    est_poses: ArrayLike, ref_poses: ArrayLike, delta: int = 1, all_pairs: bool = False
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """Relative pose errors between poses ``delta`` frames apart (evo's RPE).
+
+    For each pair ``(i, j)`` (:func:`rpe_pairs`) the error is the SE(2) pose
+    ``E = (Q_i^-1 Q_j)^-1 (P_i^-1 P_j)`` with true poses ``Q`` and estimates ``P``; the
+    translation error is ``|t(E)|`` and the rotation error ``|angle(E)|``.
+
+    Parameters
+    ----------
+    est_poses, ref_poses : array-like, shape (N, 3)
+        Associated poses ``(x, y, theta)``.
+    delta : int
+        Frame distance of the pairs.
+    all_pairs : bool
+        Use every pair ``(i, i + delta)`` instead of evo's default consecutive pairs.
+
+    Returns
+    -------
+    trans : ndarray, shape (K,)
+        Translation errors, metres.
+    rot : ndarray, shape (K,)
+        Rotation errors, radians, in [0, pi].
+    """
+    e, r = _pair(est_poses, ref_poses, (3,))
+    ij = rpe_pairs(len(e), delta, all_pairs)
+    if len(ij) == 0:
+        raise ValueError(f"RPE with delta={delta} needs at least {delta + 1} poses, got {len(e)}")
+    i, j = ij[:, 0], ij[:, 1]
+    err = relative(relative(r[i], r[j]), relative(e[i], e[j]))
+    return np.hypot(err[:, 0], err[:, 1]), np.abs(wrap_angle(err[:, 2]))
+
+
+def rpe(
+    est_poses: ArrayLike, ref_poses: ArrayLike, delta: int = 1, all_pairs: bool = False
+) -> ErrorStats:
+    """Relative pose error, translation part, metres (see :func:`rpe_errors`)."""
+    return error_stats(rpe_errors(est_poses, ref_poses, delta, all_pairs)[0])
+
+
+def rpe_rot_deg(
+    est_poses: ArrayLike, ref_poses: ArrayLike, delta: int = 1, all_pairs: bool = False
+) -> ErrorStats:
+    """Relative pose error, rotation part, degrees (see :func:`rpe_errors`)."""
+    return error_stats(np.degrees(rpe_errors(est_poses, ref_poses, delta, all_pairs)[1]))
+
+
+# ==========================================================================================
+# Map metrics: the SLAM map's line segments against the world's true walls
+# ==========================================================================================
+
+_CHUNK = 1 << 20  # elements of a (points x segments) block
+
+
+def as_segments(lines: Sequence[Line] | ArrayLike) -> NDArray[np.float64]:
+    """Segments ``[x1, y1, x2, y2]`` (M, 4) from Lines (``sp``, ``ep``) or an (M, 4) array."""
+    if isinstance(lines, Sequence) and len(lines) and isinstance(lines[0], Line):
+        return np.array([[*ln.sp, *ln.ep] for ln in lines], dtype=float).reshape(-1, 4)
+    s = np.asarray(lines, dtype=float)
+    if s.size == 0:
+        return np.zeros((0, 4))
+    if s.ndim != 2 or s.shape[1] != 4:
+        raise ValueError(f"segments must be Lines or an (M, 4) array, got shape {s.shape}")
+    return s
+
+
+def sample_segments(segments: ArrayLike, step: float = 0.05) -> NDArray[np.float64]:
+    """Points along segments, evenly spaced at most ``step`` apart, both ends included.
+
+    Parameters
+    ----------
+    segments : array-like, shape (M, 4)
+    step : float
+        Largest spacing, metres. A segment of length ``L`` gets ``ceil(L / step) + 1``
+        points (at least 2).
+
+    Returns
+    -------
+    ndarray, shape (P, 2)
+    """
+    if not step > 0:
+        raise ValueError(f"step must be positive (metres), got {step}")
+    s = as_segments(segments)
+    a, b = s[:, :2], s[:, 2:]
+    length = np.hypot(*(b - a).T)
+    n = np.maximum(np.ceil(length / step).astype(np.intp), 1)  # intervals per segment
+    seg = np.repeat(np.arange(len(s)), n + 1)
+    first = np.cumsum(n + 1) - (n + 1)
+    k = np.arange(len(seg)) - first[seg]
+    t = (k / n[seg])[:, None]
+    return a[seg] + t * (b[seg] - a[seg])
+
+
+def distance_to_segments(points: ArrayLike, segments: ArrayLike) -> NDArray[np.float64]:
+    """Distance from each point to the nearest of the segments, metres.
+
+    Broadcasts points against segments in blocks of about a million pairs.
+
+    Parameters
+    ----------
+    points : array-like, shape (P, 2)
+    segments : array-like, shape (M, 4), M >= 1
+
+    Returns
+    -------
+    ndarray, shape (P,)
+    """
+    p = np.asarray(points, dtype=float).reshape(-1, 2)
+    s = as_segments(segments)
+    if len(s) == 0:
+        raise ValueError("distance_to_segments needs at least one segment")
+    a, ab = s[:, :2], s[:, 2:] - s[:, :2]  # (M, 2)
+    denom = np.maximum(np.einsum("ij,ij->i", ab, ab), 1e-300)
+    out = np.empty(len(p))
+    rows = max(1, _CHUNK // len(s))
+    for lo in range(0, len(p), rows):
+        q = p[lo : lo + rows, None, :] - a  # (R, M, 2)
+        t = np.clip(np.einsum("rmk,mk->rm", q, ab) / denom, 0.0, 1.0)
+        d = q - t[..., None] * ab
+        out[lo : lo + rows] = np.sqrt(np.min(np.einsum("rmk,rmk->rm", d, d), axis=1))
+    return out
+
+
+def map_error(lines: Sequence[Line] | ArrayLike, walls: ArrayLike, step: float = 0.05) -> float:
+    """Mean distance from the map's segments to the true walls, metres.
+
+    Points are sampled every ``step`` metres along each map segment (:func:`sample_segments`,
+    so long lines weigh more), and each point's distance to the nearest true wall segment is
+    averaged. 0 for a map drawn exactly on the walls; it does not see walls the map misses
+    (that is :func:`map_coverage`).
+
+    Parameters
+    ----------
+    lines : sequence of Line, or array-like (M, 4)
+        The map, in the world frame (the SLAM starts at the true first pose).
+    walls : array-like, shape (W, 4)
+        True wall segments.
+    step : float
+        Sampling step along the map segments, metres.
+
+    Returns
+    -------
+    float
+        NaN for an empty map.
+    """
+    pts = sample_segments(as_segments(lines), step)
+    if len(pts) == 0:
+        return float("nan")
+    return float(np.mean(distance_to_segments(pts, walls)))
+
+
+def map_coverage(
+    lines: Sequence[Line] | ArrayLike, observed_points: ArrayLike, tol: float = 0.05
+) -> float:
+    """Share of the observed wall points that lie within ``tol`` of a map segment.
+
+    Parameters
+    ----------
+    lines : sequence of Line, or array-like (M, 4)
+        The map, in the world frame.
+    observed_points : array-like, shape (P, 2), P >= 1
+        Points on the true walls that the laser hit during the run (noise-free), e.g. from
+        :func:`observed_wall_points` or :func:`visible_wall_points`.
+    tol : float
+        Distance within which a wall point counts as mapped, metres.
+
+    Returns
+    -------
+    float
+        In [0, 1]; 0 for an empty map.
+    """
+    p = np.asarray(observed_points, dtype=float).reshape(-1, 2)
+    if len(p) == 0:
+        raise ValueError("map_coverage needs at least one observed wall point")
+    if not tol >= 0:
+        raise ValueError(f"tol must be >= 0 (metres), got {tol}")
+    s = as_segments(lines)
+    if len(s) == 0:
+        return 0.0
+    return float(np.mean(distance_to_segments(p, s) <= tol))
+
+
+def _beam_wall_points(
+    walls: NDArray, poses: NDArray, angles: NDArray, hits: NDArray
+) -> NDArray[np.float64]:
+    """Exact intersection of each beam with the wall it hit; poses (K, 3), hits (K, B)."""
+    k, b = np.nonzero(hits >= 0)
+    w = walls[hits[k, b]]
+    o = poses[k, :2]
+    a = angles[b] + poses[k, 2]
+    d = np.column_stack([np.cos(a), np.sin(a)])
+    p, e = w[:, :2] - o, w[:, 2:] - w[:, :2]
+    t = (p[:, 0] * e[:, 1] - p[:, 1] * e[:, 0]) / (d[:, 0] * e[:, 1] - d[:, 1] * e[:, 0])
+    return o + t[:, None] * d
+
+
+def observed_wall_points(log, every: int = 5) -> NDArray[np.float64]:
+    """The noise-free points where the beams of a simulated log hit the walls.
+
+    For every ``every``-th scan, each beam with a return is intersected exactly with the wall
+    it hit (``log.hits``), from the true pose (``log.truth``): the part of the world the
+    robot actually saw, for :func:`map_coverage`.
+
+    Parameters
+    ----------
+    log : fhslam.io.Log
+        A simulated log carrying ``truth``, ``hits`` and ``world``.
+    every : int
+        Use scans ``0, every, 2 every, ...``.
+
+    Returns
+    -------
+    ndarray, shape (P, 2)
+        World-frame points, metres.
+    """
+    if log.truth is None or log.hits is None or log.world is None:
+        raise ValueError(
+            f"log {log.name!r} has no ground truth (truth, hits, world): observed wall "
+            "points need a simulated log"
+        )
+    if int(every) != every or every < 1:
+        raise ValueError(f"every must be an integer >= 1, got {every}")
+    walls = np.asarray(log.world.walls, dtype=float)
+    return _beam_wall_points(walls, log.truth[::every], log.angles, log.hits[::every])
+
+
+def visible_wall_points(
+    walls: ArrayLike,
+    poses: ArrayLike,
+    every: int = 5,
+    n_beams: int = 181,
+    fov_deg: float = 180.0,
+    max_range: float = 8.0,
+) -> NDArray[np.float64]:
+    """Wall points a laser would hit from given poses: exact ray casting, no simulation.
+
+    For when only the world and the true trajectory are at hand (``fhslam evaluate
+    --world``): from every ``every``-th pose, ``n_beams`` beams spread over ``fov_deg``
+    around the heading (default: the paper's SICK LMS200, 181 beams over 180 degrees, 8 m)
+    are cast into the walls (:func:`fhslam.sim.cast_rays`) and the noise-free hit points
+    returned. For a log simulated with that laser this equals :func:`observed_wall_points`.
+
+    Parameters
+    ----------
+    walls : array-like, shape (W, 4)
+    poses : array-like, shape (T, 3)
+        True laser poses, world frame.
+    every : int
+    n_beams, fov_deg, max_range
+        The laser (beams from ``-fov/2`` to ``+fov/2``, both included; metres).
+
+    Returns
+    -------
+    ndarray, shape (P, 2)
+    """
+    from fhslam.sim.laser import cast_rays  # metrics sits above sim; import on use
+
+    if int(every) != every or every < 1:
+        raise ValueError(f"every must be an integer >= 1, got {every}")
+    w = np.asarray(walls, dtype=float).reshape(-1, 4)
+    q = _poses(poses, "poses")[:: int(every)]
+    half = np.radians(fov_deg) / 2
+    angles = np.linspace(-half, half, int(n_beams))
+    hits = np.array([cast_rays(w, pose, angles, max_range)[1] for pose in q], dtype=np.intp)
+    return _beam_wall_points(w, q, angles, hits.reshape(len(q), len(angles)))

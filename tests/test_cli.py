@@ -127,3 +127,89 @@ def test_bench_table_has_every_extractor(capsys):
         "OpenCV HoughLinesP (raster)",
     ):
         assert name in out
+
+
+# ----------------------------------------------------------------------------- evaluate
+
+
+@pytest.fixture(scope="module")
+def truth_file(tmp_path_factory):
+    """The ground truth of the paper world (seed 0), written as a truth file."""
+    from fhslam.io import write_trajectory
+
+    log = simulate(paper_world(), seed=0)
+    path = tmp_path_factory.mktemp("evaluate") / "truth.txt"
+    write_trajectory(path, log.timestamps, log.truth, header="truth: timestamp x y theta")
+    return path
+
+
+def test_evaluate_truth_against_itself_is_zero(truth_file, capsys):
+    assert main(["evaluate", str(truth_file), "--truth", str(truth_file), "--json"]) == 0
+    out = capsys.readouterr().out
+    assert out.count("\n") == 1  # one JSON object
+    result = json.loads(out)
+    assert result["ate_rmse"] == 0.0 and result["rpe_trans_mean"] < 1e-12
+    assert result["n_poses"] == 916
+    for key in ("ate_mean", "ate_median", "ate_std", "ate_min", "ate_max", "rpe_trans_rmse"):
+        assert key in result
+    assert "rpe_rot_mean_deg" in result and "map_error" not in result
+
+
+def test_evaluate_shifted_copy_gives_half_a_metre(truth_file, tmp_path, capsys):
+    from fhslam.io import write_trajectory
+
+    t, poses = read_trajectory(truth_file)
+    shifted = tmp_path / "shifted.txt"
+    write_trajectory(shifted, t + 0.004, poses + np.array([0.3, 0.4, 0.0]))  # jittered stamps
+    assert main(["evaluate", str(shifted), "--truth", str(truth_file), "--json"]) == 0
+    result = json.loads(capsys.readouterr().out)
+    assert result["ate_rmse"] == pytest.approx(0.5, abs=1e-12)
+    assert result["ate_max"] == pytest.approx(0.5, abs=1e-12)
+    assert result["rpe_trans_max"] < 1e-12
+    assert result["n_poses"] == 916
+    # The same with --align is 0, and the readable table says so.
+    assert main(["evaluate", str(shifted), "--truth", str(truth_file), "--align"]) == 0
+    text = capsys.readouterr().out
+    assert "ATE aligned (m)" in text and "RPE rot (deg)" in text and "916 poses" in text
+
+
+def test_evaluate_malformed_trajectory_line(truth_file, tmp_path):
+    bad = tmp_path / "traj.txt"
+    bad.write_text("# t x y theta\n0.0 0 0 0\n0.2 0 0\n")
+    r = run("evaluate", str(bad), "--truth", str(truth_file), "--json")
+    assert r.returncode == 2 and r.stdout == ""
+    assert r.stderr.count("\n") == 1 and "Traceback" not in r.stderr
+    assert "traj.txt:3:" in r.stderr
+
+
+def test_evaluate_needs_two_matched_poses(truth_file, tmp_path):
+    late = tmp_path / "late.txt"
+    late.write_text("1000.0 0 0 0\n1000.2 0 0 0\n")
+    r = run("evaluate", str(late), "--truth", str(truth_file))
+    assert r.returncode == 2 and r.stderr.count("\n") == 1
+    assert "late.txt" in r.stderr and "truth.txt" in r.stderr and "only 0 poses" in r.stderr
+
+
+def test_evaluate_map_of_the_true_walls(truth_file, tmp_path, capsys):
+    from fhslam.io import lines_from_segments, write_map
+
+    map_path = tmp_path / "walls.json"
+    write_map(map_path, lines_from_segments(paper_world().walls))
+    argv = ["evaluate", str(truth_file), "--truth", str(truth_file)]
+    assert main([*argv, "--world", "paper", "--map", str(map_path), "--json"]) == 0
+    result = json.loads(capsys.readouterr().out)
+    assert result["map_error"] < 1e-9
+    assert result["map_coverage"] > 0.99
+    assert result["n_map_lines"] == len(paper_world().walls)
+    # Half the walls: the coverage drops, the error stays 0.
+    write_map(map_path, lines_from_segments(paper_world().walls[::2]))
+    assert main([*argv, "--world", "paper", "--map", str(map_path), "--json"]) == 0
+    result = json.loads(capsys.readouterr().out)
+    assert result["map_error"] < 1e-9 and 0.1 < result["map_coverage"] < 0.9
+    # --world without --map, and a malformed map: one-line errors.
+    r = run(*argv, "--world", "paper")
+    assert r.returncode == 2 and "--map" in r.stderr and r.stderr.count("\n") == 1
+    map_path.write_text('{"lines": [{"sp": [0, 0]}]}')
+    r = run(*argv, "--world", "paper", "--map", str(map_path))
+    assert r.returncode == 2 and "walls.json: lines[0]" in r.stderr
+    assert r.stderr.count("\n") == 1 and "Traceback" not in r.stderr

@@ -16,6 +16,7 @@ from fhslam.sim import (
     add_range_noise,
     beam_angles,
     cast_rays,
+    degrade,
     load_world,
     odometry_from_truth,
     paper_world,
@@ -23,7 +24,7 @@ from fhslam.sim import (
     route_clearance,
     simulate,
 )
-from fhslam.sim.simulate import follow_route
+from fhslam.sim.simulate import follow_route, lap_route
 
 # A 4 x 4 m room centred on the origin: bottom, right, top, left.
 SQUARE = np.array([[-2, -2, 2, -2], [2, -2, 2, 2], [2, 2, -2, 2], [-2, 2, -2, -2]], dtype=float)
@@ -274,3 +275,237 @@ def test_load_world_malformed_files_name_file_and_field(tmp_path, content, match
     path.write_text(content)
     with pytest.raises(WorldFormatError, match=rf"bad_world\.json: .*{match}"):
         load_world(path)
+
+
+# ---------------------------------------------------------------------------- drifting odometry
+
+# Two beams: the laser stream is independent of the odometry stream, so the odometry (and
+# the drift) is the same as with the full 181-beam laser, at a fraction of the casting cost.
+TWO_BEAMS = LaserParams(n_beams=2)
+
+
+def max_and_final_drift(log) -> tuple[float, float]:
+    """Largest and final distance between odometry and true position over a log, metres."""
+    err = np.hypot(*(log.odometry[:, :2] - log.truth[:, :2]).T)
+    return float(err.max()), float(err[-1])
+
+
+def test_drifting_preset_drifts_2_to_6_m_on_the_paper_world():
+    log = simulate(paper_world(), seed=0, odometry=OdometryNoise.drifting())
+    worst, final = max_and_final_drift(log)
+    assert 2.0 <= worst <= 6.0
+    assert 2.0 <= final <= 6.0
+    # The default noise drifts far less: the preset is what makes the run hard.
+    assert max_and_final_drift(simulate(paper_world(), seed=0))[0] < 2.0
+
+
+def test_drifting_preset_is_mostly_systematic():
+    noise = OdometryNoise.drifting()
+    assert noise.heading_bias > 0 and noise.turn_scale_error > 0 and noise.scale_error > 0
+    default = OdometryNoise()
+    assert noise.alpha1 < default.alpha1 and noise.alpha3 < default.alpha3
+
+
+def test_drifting_preset_drift_over_seeds_as_documented():
+    # The docstring states: paper world seeds 0-19, and random_world(s) for s = 101-120
+    # driven 3 laps with seed=s, all drift 2-6 m at worst.
+    noise = OdometryNoise.drifting()
+    paper = [
+        max_and_final_drift(simulate(paper_world(), seed=s, laser=TWO_BEAMS, odometry=noise))
+        for s in range(20)
+    ]
+    rand = [
+        max_and_final_drift(
+            simulate(random_world(s), seed=s, laser=TWO_BEAMS, odometry=noise, laps=3)
+        )
+        for s in range(101, 121)
+    ]
+    for drifts in (np.array(paper), np.array(rand)):
+        assert np.all((drifts[:, 0] >= 2.0) & (drifts[:, 0] <= 6.0)), drifts[:, 0]
+        assert 3.0 <= np.median(drifts[:, 0]) <= 4.5
+        assert np.all(drifts[:, 1] <= drifts[:, 0])
+
+
+def test_turn_scale_error_scales_every_rotation():
+    # A robot turning on the spot by 0.1 rad per step: odometry reports 1.1 times that.
+    truth = np.column_stack([np.zeros(11), np.zeros(11), np.linspace(0.0, 1.0, 11)])
+    noise = OdometryNoise(0.0, 0.0, 0.0, 0.0, 0.0, 0.0, turn_scale_error=0.1)
+    odom = odometry_from_truth(truth, noise, np.random.default_rng(0))
+    np.testing.assert_allclose(odom[:, 2], 1.1 * truth[:, 2], atol=1e-12)
+    np.testing.assert_allclose(odom[:, :2], 0.0, atol=1e-12)
+    with pytest.raises(ValueError, match="turn_scale_error"):
+        OdometryNoise(turn_scale_error=-1.0)
+
+
+# ---------------------------------------------------------------------------- laps
+
+
+def path_length(truth: np.ndarray) -> float:
+    return float(np.hypot(*np.diff(truth[:, :2], axis=0).T).sum())
+
+
+@pytest.mark.parametrize("seed", [101, 107])
+def test_three_laps_triple_the_path_on_a_random_world(seed):
+    world = random_world(seed)
+    one, three = follow_route(world), follow_route(world, laps=3)
+    assert path_length(three) == pytest.approx(3 * path_length(one), rel=0.02)
+    assert 50 < path_length(three) < 75  # 18-25 m loops
+    assert np.hypot(*(three[-1, :2] - world.route[0])) < 0.5  # back at the start
+    assert wall_distances(three[:, :2], world.walls).min() >= 0.3
+    # The first lap is driven exactly as a single lap.
+    np.testing.assert_array_equal(three[: len(one) - 1], one[:-1])
+
+
+def test_simulate_laps_keeps_the_one_lap_world():
+    world = random_world(101)
+    log = simulate(world, seed=0, laser=TWO_BEAMS, laps=2)
+    assert log.world is world
+    assert path_length(log.truth) == pytest.approx(2 * path_length(follow_route(world)), rel=0.02)
+
+
+def test_laps_on_an_open_route_raise():
+    with pytest.raises(ValueError, match=r"laps=3 needs a closed route"):
+        simulate(paper_world(), laps=3)
+    with pytest.raises(ValueError, match="closed route"):
+        follow_route(paper_world(), laps=2)
+    assert len(simulate(paper_world(), laps=1, max_scans=3)) == 3  # one lap is fine
+
+
+@pytest.mark.parametrize("laps", [0, -1, 1.5, True])
+def test_laps_must_be_a_positive_integer(laps):
+    with pytest.raises(ValueError, match="laps must be an integer >= 1"):
+        follow_route(random_world(101), laps=laps)
+
+
+def test_lap_route_tiles_a_closed_route():
+    square = np.array([[0, 0], [1, 0], [1, 1], [0, 1], [0, 0]], dtype=float)
+    tiled = lap_route(square, 3)
+    assert tiled.shape == (13, 2)
+    np.testing.assert_array_equal(tiled[4::4], np.zeros((3, 2)))
+    np.testing.assert_array_equal(lap_route(square, 1), square)
+    with pytest.raises(ValueError, match="closed route"):
+        lap_route(square[:-1], 2)
+
+
+# ---------------------------------------------------------------------------- degrade
+
+
+@pytest.fixture(scope="module")
+def degraded(paper_log):
+    return degrade(paper_log, drop_fraction=0.1, clutter_fraction=0.05, seed=7)
+
+
+def kept_rows(log, degraded_log) -> np.ndarray:
+    """Indices into ``log`` of the scans ``degraded_log`` kept (timestamps are unique)."""
+    idx = np.searchsorted(log.timestamps, degraded_log.timestamps)
+    assert np.array_equal(log.timestamps[idx], degraded_log.timestamps)
+    return idx
+
+
+def test_degrade_drops_the_stated_number_of_scans_never_the_first(paper_log, degraded):
+    t = len(paper_log)
+    assert len(degraded) == t - round(0.1 * (t - 1))
+    assert degraded.timestamps[0] == paper_log.timestamps[0]
+    rows = kept_rows(paper_log, degraded)
+    assert rows[0] == 0 and np.all(np.diff(rows) > 0)
+    # Whole rows go: odometry and truth follow the kept scans.
+    np.testing.assert_array_equal(degraded.odometry, paper_log.odometry[rows])
+    np.testing.assert_array_equal(degraded.truth, paper_log.truth[rows])
+    assert degraded.ranges.shape == (len(degraded), 181) and degraded.hits.shape == (
+        len(degraded),
+        181,
+    )
+    assert degraded.world is paper_log.world and degraded.max_range == paper_log.max_range
+
+
+@pytest.mark.parametrize(
+    ("t", "fraction", "dropped"),
+    [(11, 0.1, 1), (11, 0.5, 5), (2, 0.9, 1), (1, 0.5, 0), (101, 0.0, 0)],
+)
+def test_degrade_drop_count_rule(paper_log, t, fraction, dropped):
+    short = simulate(paper_world(), seed=0, laser=TWO_BEAMS, max_scans=t)
+    out = degrade(short, drop_fraction=fraction, seed=1)
+    assert len(out) == t - dropped
+    assert out.timestamps[0] == 0.0
+
+
+def test_degrade_clutter_share_ranges_and_hits(paper_log, degraded):
+    rows = kept_rows(paper_log, degraded)
+    before, after = paper_log.ranges[rows], degraded.ranges
+    valid = before < paper_log.max_range
+    changed = after != before
+    clutter = degraded.hits == -1
+    assert np.array_equal(changed, clutter & valid)  # clutter only on valid beams, hits -1
+    share = changed.sum() / valid.sum()
+    assert share == pytest.approx(0.05, abs=0.01)
+    # Every scan gets its share, give or take the rounding of the per-scan count.
+    per_scan = changed.sum(axis=1) - 0.05 * valid.sum(axis=1)
+    assert np.all(np.abs(per_scan) < 1.0)
+    # Clutter is short of the wall: within [0.3 m, 0.9 x the logged range] up to rounding,
+    # and shorter than the noise-free range to the wall.
+    true_range = np.array(
+        [cast_rays(paper_log.world.walls, p, paper_log.angles, 8.0)[0] for p in degraded.truth]
+    )
+    fake, wall = after[changed], before[changed]
+    assert np.all(fake >= 0.3 - 0.0005) and np.all(fake <= 0.9 * wall + 0.0005)
+    assert np.all(fake < true_range[changed])
+    assert fake.min() < 0.5 and np.median(fake / wall) < 0.7  # spread over the interval
+    # Still quantised to the laser's 1 mm.
+    np.testing.assert_allclose(after * 1000, np.round(after * 1000), atol=1e-6)
+    # Everything else is untouched.
+    np.testing.assert_array_equal(after[~changed], before[~changed])
+    np.testing.assert_array_equal(degraded.hits[~changed], paper_log.hits[rows][~changed])
+
+
+def test_degrade_is_deterministic_per_seed_and_leaves_the_input_alone(paper_log, degraded):
+    ranges_before = paper_log.ranges.copy()
+    again = degrade(paper_log, drop_fraction=0.1, clutter_fraction=0.05, seed=7)
+    for field in ("timestamps", "ranges", "odometry", "truth", "hits"):
+        assert np.array_equal(getattr(again, field), getattr(degraded, field)), field
+    other = degrade(paper_log, drop_fraction=0.1, clutter_fraction=0.05, seed=8)
+    assert not np.array_equal(other.timestamps, degraded.timestamps)
+    assert np.array_equal(paper_log.ranges, ranges_before)
+
+
+def test_degrade_choices_are_nested_across_fractions(paper_log):
+    light = degrade(paper_log, drop_fraction=0.05, clutter_fraction=0.02, seed=3)
+    heavy = degrade(paper_log, drop_fraction=0.2, clutter_fraction=0.1, seed=3)
+    assert set(heavy.timestamps) <= set(light.timestamps)
+    # Same clutter draws: a beam cluttered in the light log is cluttered the same way in the
+    # heavy one (where the scan survives).
+    rows = np.searchsorted(light.timestamps, heavy.timestamps)
+    light_clutter = light.ranges[rows] != paper_log.ranges[kept_rows(paper_log, heavy)]
+    np.testing.assert_array_equal(heavy.ranges[light_clutter], light.ranges[rows][light_clutter])
+
+
+def test_degrade_with_zero_fractions_copies(paper_log):
+    out = degrade(paper_log)
+    assert out is not paper_log and out.ranges is not paper_log.ranges
+    for field in ("timestamps", "ranges", "odometry", "truth", "hits"):
+        assert np.array_equal(getattr(out, field), getattr(paper_log, field)), field
+
+
+def test_degrade_works_without_truth_or_hits(paper_log):
+    from fhslam.io.log import Log
+
+    bare = Log(name="real", timestamps=paper_log.timestamps, ranges=paper_log.ranges,
+               angles=paper_log.angles, odometry=paper_log.odometry, max_range=8.0)  # fmt: skip
+    out = degrade(bare, drop_fraction=0.1, clutter_fraction=0.05, seed=7)
+    assert out.truth is None and out.hits is None
+    assert len(out) == len(bare) - round(0.1 * (len(bare) - 1))
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "match"),
+    [
+        ({"drop_fraction": 1.0}, "drop_fraction"),
+        ({"drop_fraction": -0.1}, "drop_fraction"),
+        ({"clutter_fraction": 1.5}, "clutter_fraction"),
+        ({"clutter_fraction": float("nan")}, "clutter_fraction"),
+        ({"clutter_fraction": "lots"}, "clutter_fraction"),
+        ({"resolution": -0.001}, "resolution"),
+    ],
+)
+def test_degrade_rejects_bad_arguments(paper_log, kwargs, match):
+    with pytest.raises(ValueError, match=match):
+        degrade(paper_log, **kwargs)

@@ -1,8 +1,10 @@
-"""Simulation: polygonal worlds, a ray-casting laser, drifting odometry, and `simulate()`."""
+"""Simulation: polygonal worlds, a ray-casting laser, drifting odometry, `simulate()`, and
+`degrade()` (dropped scans, clutter returns)."""
 
+from fhslam.sim.degrade import degrade
 from fhslam.sim.laser import LaserParams, add_range_noise, beam_angles, cast_rays
 from fhslam.sim.odometry import OdometryNoise, odometry_from_truth
-from fhslam.sim.simulate import MotionParams, follow_route, simulate
+from fhslam.sim.simulate import MotionParams, follow_route, is_closed_route, lap_route, simulate
 from fhslam.sim.world import (
     World,
     WorldFormatError,
@@ -22,7 +24,10 @@ __all__ = [
     "add_range_noise",
     "beam_angles",
     "cast_rays",
+    "degrade",
     "follow_route",
+    "is_closed_route",
+    "lap_route",
     "load_world",
     "odometry_from_truth",
     "paper_world",

@@ -66,14 +66,62 @@ class MotionParams:
             raise ValueError(f"MotionParams.substeps must be an integer >= 1, got {self.substeps}")
 
 
+def is_closed_route(route: NDArray[np.float64], tolerance: float = 1e-6) -> bool:
+    """Whether a route ``(K, 2)`` is a closed loop: its last waypoint is its first.
+
+    ``tolerance`` (metres) absorbs rounding, e.g. of a route read back from JSON.
+    """
+    return bool(len(route) >= 3 and np.hypot(*(route[-1] - route[0])) <= tolerance)
+
+
+def lap_route(route: NDArray[np.float64], laps: int) -> NDArray[np.float64]:
+    """The waypoints of ``laps`` consecutive laps of a closed ``route`` (K, 2).
+
+    Returns
+    -------
+    ndarray, shape (laps * (K - 1) + 1, 2)
+        ``route`` followed ``laps - 1`` more times by ``route[1:]``; ``route`` itself (a copy)
+        for ``laps == 1``.
+
+    Raises
+    ------
+    ValueError
+        If ``laps`` is not an integer >= 1, or ``laps > 1`` for an open route (one whose
+        last waypoint is not its first: driving it again would teleport the robot back).
+    """
+    route = np.asarray(route, dtype=float)
+    if isinstance(laps, bool) or int(laps) != laps or laps < 1:
+        raise ValueError(f"laps must be an integer >= 1, got {laps!r}")
+    laps = int(laps)
+    if laps > 1 and not is_closed_route(route):
+        raise ValueError(
+            f"laps={laps} needs a closed route (last waypoint equal to the first); this route "
+            f"runs from {route[0].tolist()} to {route[-1].tolist()}"
+        )
+    return np.vstack([route, *([route[1:]] * (laps - 1))])
+
+
 def follow_route(
-    world: World, motion: MotionParams | None = None, max_scans: int | None = None
+    world: World,
+    motion: MotionParams | None = None,
+    max_scans: int | None = None,
+    laps: int = 1,
 ) -> NDArray[np.float64]:
     """True poses at the scan times while driving ``world.route`` from ``world.start``.
 
     Deterministic (no noise): a unicycle integrated with the midpoint rule, steered by the
     controller described in :class:`MotionParams`. The run ends at the first scan after the
-    last waypoint is reached, or after ``max_scans`` scans.
+    last waypoint (of the last lap) is reached, or after ``max_scans`` scans.
+
+    Parameters
+    ----------
+    world : World
+    motion : MotionParams, optional
+    max_scans : int, optional
+        Stop after this many scans.
+    laps : int
+        How many times to drive a closed route (see :func:`lap_route`); open routes allow
+        only 1.
 
     Returns
     -------
@@ -81,14 +129,15 @@ def follow_route(
         Pose ``(x, y, theta)`` at scan times ``0, period, 2 period, ...``.
     """
     m = MotionParams() if motion is None else motion
-    route = world.route
+    route = lap_route(world.route, laps)
     pose = world.start.astype(float).copy()
     tol = m.waypoint_tolerance
     target = 1 if np.hypot(*(route[0] - pose[:2])) <= tol else 0
     dt = m.scan_period / m.substeps
     drive_angle = np.radians(m.drive_angle_deg)
     # A generous bound on the scans needed: driving time plus half a turn per waypoint, x3.
-    expected = world.route_length / m.speed + len(route) * np.pi / m.max_turn_rate
+    length = float(np.hypot(*np.diff(route, axis=0).T).sum())
+    expected = length / m.speed + len(route) * np.pi / m.max_turn_rate
     limit = int(3 * expected / m.scan_period) + 100 if max_scans is None else int(max_scans)
     poses = [pose.copy()]
     done = False
@@ -133,6 +182,7 @@ def simulate(
     odometry: OdometryNoise = DEFAULT_ODOMETRY,
     motion: MotionParams = DEFAULT_MOTION,
     max_scans: int | None = None,
+    laps: int = 1,
 ) -> Log:
     """Drive ``world``'s route and record noisy scans and drifting odometry.
 
@@ -147,6 +197,10 @@ def simulate(
     motion : MotionParams
     max_scans : int, optional
         Stop after this many scans (default: at the end of the route).
+    laps : int
+        Drive a closed route (last waypoint equal to the first, as in every
+        :func:`~fhslam.sim.random_world`) this many times in a row, for longer runs with
+        more drift and more loop closures. ``Log.world`` keeps the one-lap route.
 
     Returns
     -------
@@ -154,10 +208,16 @@ def simulate(
         ``timestamps[k] = round(k * scan_period, 6)``, noisy ``ranges`` (T, B), ``angles``
         (B,), ``odometry`` (T, 3), and the simulation's ``truth`` (T, 3), ``hits`` (T, B)
         and ``world``.
+
+    Raises
+    ------
+    ValueError
+        For ``max_scans < 1``, ``laps < 1``, or ``laps > 1`` on an open route (such as the
+        paper world's, which ends at the far end of the corridor).
     """
     if max_scans is not None and (int(max_scans) != max_scans or max_scans < 1):
         raise ValueError(f"max_scans must be a positive integer or None, got {max_scans!r}")
-    truth = follow_route(world, motion, max_scans)
+    truth = follow_route(world, motion, max_scans, laps)
     laser_rng, odom_rng = (np.random.default_rng(s) for s in np.random.SeedSequence(seed).spawn(2))
     angles = beam_angles(laser)
     clean = np.empty((len(truth), len(angles)))

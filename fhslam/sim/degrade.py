@@ -1,0 +1,132 @@
+"""Degrade a log as a harsher world would: lost laser messages and clutter returns.
+
+:func:`degrade` works on any :class:`~fhslam.io.log.Log`, simulated or read from a file; the
+ground truth and wall hits of a simulated log follow the kept scans.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from fhslam.io.log import Log
+
+CLUTTER_MIN_RANGE = 0.3
+"""Nearest clutter return, metres (about the closest a person or chair gets to the laser)."""
+
+CLUTTER_MAX_FRACTION = 0.9
+"""Farthest clutter return, as a fraction of the beam's own (wall) range."""
+
+
+def _check_fraction(name: str, value: float) -> float:
+    if isinstance(value, bool):
+        raise ValueError(f"{name} must be a number in [0, 1), got {value!r}")
+    try:
+        f = float(value)
+    except (TypeError, ValueError):
+        raise ValueError(f"{name} must be a number in [0, 1), got {value!r}") from None
+    if not 0.0 <= f < 1.0:  # also rejects NaN
+        raise ValueError(f"{name} must be in [0, 1), got {value!r}")
+    return f
+
+
+def degrade(
+    log: Log,
+    drop_fraction: float = 0.0,
+    clutter_fraction: float = 0.0,
+    seed: int = 0,
+    resolution: float = 0.001,
+) -> Log:
+    """A copy of ``log`` with scans lost and clutter returns added.
+
+    1. **Dropped scans.** ``round(drop_fraction * (T - 1))`` scans (Python's ``round``),
+       chosen at random but never the first, are removed entirely: their timestamp, ranges,
+       odometry, and (if present) truth and hits rows, as if the laser messages were lost.
+       The kept scans keep their own timestamps, so the log has gaps in time.
+    2. **Clutter.** In every kept scan, a ``clutter_fraction`` share of the valid beams
+       (finite, ``0 < range < max_range``) reads a return short of the wall, as from people
+       or chairs: range uniform in ``[0.3 m, 0.9 * r]``, where ``r`` is the beam's range in
+       ``log`` (both ends lowered to ``0.9 * r`` if that is below 0.3 m), rounded to
+       ``resolution``. Their ``hits`` become -1 (no wall). The number of clutter beams in a
+       scan with ``n`` valid beams is ``clutter_fraction * n`` rounded up or down at random
+       (up with probability its fractional part), so the share over a log is unbiased.
+
+    The random choices are fixed by ``seed`` and independent of the two fractions: a larger
+    ``drop_fraction`` drops a superset of the scans a smaller one drops, a larger
+    ``clutter_fraction`` clutters a superset of the beams, and a beam's clutter range does
+    not depend on either fraction. Clutter is drawn for all scans before any are dropped.
+
+    Parameters
+    ----------
+    log : Log
+        The log to degrade; it is not modified.
+    drop_fraction : float
+        Share of the scans after the first to remove, in [0, 1).
+    clutter_fraction : float
+        Share of each kept scan's valid beams to turn into clutter, in [0, 1).
+    seed : int
+        Seed of the random choices.
+    resolution : float
+        Clutter ranges are rounded to multiples of this, metres (the LMS200's 1 mm); 0 keeps
+        them unrounded. Ranges that are not clutter are copied unchanged.
+
+    Returns
+    -------
+    Log
+        A new log with ``T - round(drop_fraction * (T - 1))`` scans, the same ``name``,
+        ``angles``, ``max_range`` and ``world``; arrays are copies.
+
+    Raises
+    ------
+    ValueError
+        If a fraction is outside [0, 1) or not a number, or ``resolution`` is negative.
+    """
+    drop = _check_fraction("drop_fraction", drop_fraction)
+    clutter = _check_fraction("clutter_fraction", clutter_fraction)
+    if not (np.isfinite(resolution) and resolution >= 0):
+        raise ValueError(f"resolution must be >= 0, got {resolution!r}")
+    drop_rng, clutter_rng = (
+        np.random.default_rng(s) for s in np.random.SeedSequence(seed).spawn(2)
+    )
+    t, b = log.ranges.shape
+
+    # Clutter, drawn for all T scans with every random number used whatever the fractions.
+    ranges = log.ranges.copy()
+    hits = None if log.hits is None else log.hits.copy()
+    keys = clutter_rng.random((t, b))  # beam order of selection: smallest key first
+    round_up = clutter_rng.random(t)  # stochastic rounding of the per-scan count
+    position = clutter_rng.random((t, b))  # where in [low, high] a clutter return lies
+    with np.errstate(invalid="ignore"):
+        valid = np.isfinite(ranges) & (ranges > 0) & (ranges < log.max_range)
+    count = np.floor(clutter * valid.sum(axis=1) + round_up).astype(np.intp)  # (T,)
+    rank = np.argsort(np.argsort(np.where(valid, keys, np.inf), axis=1), axis=1)
+    is_clutter = valid & (rank < count[:, None])
+    r = ranges[is_clutter]
+    high = CLUTTER_MAX_FRACTION * r
+    low = np.minimum(CLUTTER_MIN_RANGE, high)
+    fake = low + position[is_clutter] * (high - low)
+    if resolution > 0:
+        # Round to the sensor's step (twice: the second removes float dust); never up to r.
+        fake = np.round(np.round(fake / resolution) * resolution, 9)
+        fake = np.where(fake >= r, r - resolution, fake)
+        fake = np.maximum(fake, resolution)
+    ranges[is_clutter] = fake
+    if hits is not None:
+        hits[is_clutter] = -1
+
+    # Dropped scans: a random order of scans 1..T-1, the first n of which are lost.
+    n_drop = round(drop * max(t - 1, 0))
+    order = drop_rng.permutation(np.arange(1, max(t, 1)))
+    keep = np.ones(t, dtype=bool)
+    keep[order[:n_drop]] = False
+
+    return Log(
+        name=log.name,
+        timestamps=log.timestamps[keep].copy(),
+        ranges=ranges[keep],
+        angles=log.angles.copy(),
+        odometry=log.odometry[keep].copy(),
+        max_range=log.max_range,
+        truth=None if log.truth is None else log.truth[keep].copy(),
+        hits=None if hits is None else hits[keep],
+        world=log.world,
+    )

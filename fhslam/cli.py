@@ -15,10 +15,11 @@ EXIT_BAD_INPUT = 2
 
 def _simulate(args: argparse.Namespace) -> None:
     from fhslam.io import write_carmen, write_trajectory
-    from fhslam.sim import load_world, simulate
+    from fhslam.sim import OdometryNoise, load_world, simulate
 
     world = load_world(args.world)
-    log = simulate(world, seed=args.seed)
+    noise = OdometryNoise.drifting() if args.odometry == "drifting" else OdometryNoise()
+    log = simulate(world, seed=args.seed, odometry=noise, laps=args.laps)
     write_carmen(log, args.log)
     write_trajectory(
         args.truth,
@@ -144,11 +145,32 @@ def _reproduce(args: argparse.Namespace) -> None:
         print(path)
 
 
+def _slam(args: argparse.Namespace) -> None:
+    from fhslam.io import read_carmen, write_map, write_trajectory
+    from fhslam.slam import run_slam
+
+    log = read_carmen(args.log)
+    result = run_slam(log, args.method, progress=not args.quiet and len(log) > 200)
+    # Everything is computed before anything is written: bad input leaves no half files.
+    write_trajectory(
+        args.trajectory,
+        result.timestamps,
+        result.poses,
+        header=f"fhslam slam --method {args.method} {args.log}: timestamp x y theta",
+    )
+    if args.map is not None:
+        write_map(args.map, result.map)
+    extra = f" and {len(result.map)} map lines to {args.map}" if args.map else ""
+    print(f"wrote {len(result.poses)} poses to {args.trajectory}{extra}")
+
+
 def _bench(args: argparse.Namespace) -> None:
-    from fhslam.bench import format_table, run_bench
+    from fhslam.bench import format_slam_table, format_table, run_bench, run_slam_bench
 
     rows = run_bench(scans_per_world=args.scans, repeats=args.repeats, progress=not args.quiet)
     print(format_table(rows))
+    print()
+    print(format_slam_table(run_slam_bench()))
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -163,7 +185,27 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
     p.add_argument("--log", required=True, type=Path, help="output CARMEN log (.clf)")
     p.add_argument("--truth", required=True, type=Path, help="output truth file")
+    p.add_argument(
+        "--odometry",
+        choices=("default", "drifting"),
+        default="default",
+        help="odometry noise: default (~1 m drift on the paper route) or drifting (2-6 m)",
+    )
+    p.add_argument("--laps", type=int, default=1, help="drive a closed route this many times")
     p.set_defaults(run=_simulate)
+
+    p = sub.add_parser("slam", help="run SLAM on a log: trajectory and line map")
+    p.add_argument("log", type=Path, help="CARMEN text log (.clf)")
+    p.add_argument(
+        "--method",
+        choices=("fht", "odometry"),
+        default="fht",
+        help="fht: fast-Hough SLAM (default); odometry: dead reckoning",
+    )
+    p.add_argument("--trajectory", required=True, type=Path, help="output: timestamp x y theta")
+    p.add_argument("--map", type=Path, help="output map JSON (reference lines)")
+    p.add_argument("--quiet", action="store_true", help="no progress bar")
+    p.set_defaults(run=_slam)
 
     p = sub.add_parser("info", help="summarise a CARMEN log: scans, beams, lines per scan")
     p.add_argument("log", type=Path, help="CARMEN text log (.clf)")

@@ -81,3 +81,43 @@ def test_perfect_odometry_stays_on_the_truth(paper_log_perfect):
     r = run_slam(paper_log_perfect)
     err = np.hypot(*(r.poses[:, :2] - paper_log_perfect.truth[:, :2]).T)
     assert np.sqrt(np.mean(err**2)) < 0.02  # FH-SLAM must not corrupt a correct pose
+
+
+# --------------------------------------------------------------------------- acceptance
+
+HELD_OUT = ("random:101", "random:106", "random:109", "random:118")
+"""Worlds FH-SLAM was not tuned on (it was developed on the paper world only)."""
+
+
+def _run(name, laps, degraded=False):
+    from fhslam.metrics import ate, map_coverage, map_error, observed_wall_points
+    from fhslam.sim import OdometryNoise, degrade, load_world, simulate
+
+    log = simulate(load_world(name), seed=0, odometry=OdometryNoise.drifting(), laps=laps)
+    if degraded:
+        log = degrade(log, drop_fraction=0.1, clutter_fraction=0.05, seed=1)
+    r = run_slam(log)
+    return {
+        "ate": ate(r.poses, log.truth).rmse,
+        "odometry_ate": ate(log.odometry, log.truth).rmse,
+        "drift": np.hypot(*(log.odometry[:, :2] - log.truth[:, :2]).T).max(),
+        "map_error": map_error(r.map, log.world.walls),
+        "coverage": map_coverage(r.map, observed_wall_points(log)),
+    }
+
+
+@pytest.mark.parametrize("world", HELD_OUT)
+def test_fh_slam_on_held_out_worlds_meets_issue_3(world):
+    m = _run(world, laps=3)
+    assert 2.0 <= m["drift"] <= 6.0  # the odometry really drifts 2-6 m
+    assert m["ate"] <= 0.15 and m["ate"] <= 0.2 * m["odometry_ate"]
+    assert m["map_error"] <= 0.05
+    assert m["coverage"] >= 0.80
+
+
+@pytest.mark.parametrize(("world", "laps"), [("paper", 1), ("random:110", 3)])
+def test_dropped_scans_and_clutter_at_most_double_the_ate(world, laps):
+    """10% of scans dropped and 5% clutter returns (short of the wall)."""
+    clean, bad = _run(world, laps), _run(world, laps, degraded=True)
+    assert bad["ate"] <= 2.0 * clean["ate"]
+    assert bad["ate"] <= 0.15

@@ -213,3 +213,63 @@ def test_evaluate_map_of_the_true_walls(truth_file, tmp_path, capsys):
     r = run(*argv, "--world", "paper", "--map", str(map_path))
     assert r.returncode == 2 and "walls.json: lines[0]" in r.stderr
     assert r.stderr.count("\n") == 1 and "Traceback" not in r.stderr
+
+
+def test_slam_then_evaluate_beats_odometry(tmp_path):
+    log, truth = tmp_path / "r.clf", tmp_path / "truth.txt"
+    assert (
+        main(
+            [
+                "simulate",
+                "random:105",
+                "--odometry",
+                "drifting",
+                "--laps",
+                "3",
+                "--log",
+                str(log),
+                "--truth",
+                str(truth),
+            ]
+        )
+        == 0
+    )
+    fht, odo, mp = tmp_path / "fht.txt", tmp_path / "odo.txt", tmp_path / "map.json"
+    r = run("slam", str(log), "--trajectory", str(fht), "--map", str(mp), "--quiet")
+    assert r.returncode == 0, r.stderr
+    assert main(["slam", str(log), "--method", "odometry", "--trajectory", str(odo)]) == 0
+    t_fht, _ = read_trajectory(fht)
+    t_log = read_carmen(log).timestamps
+    np.testing.assert_array_equal(t_fht, t_log)  # one line per scan, the scan's own stamp
+    scores = {}
+    for name, traj in [("fht", fht), ("odo", odo)]:
+        r = run(
+            "evaluate",
+            str(traj),
+            "--truth",
+            str(truth),
+            "--world",
+            "random:105",
+            "--map",
+            str(mp),
+            "--json",
+        )
+        assert r.returncode == 0, r.stderr
+        scores[name] = json.loads(r.stdout)
+    assert scores["odo"]["ate_rmse"] > 1.0  # drifting odometry
+    assert scores["fht"]["ate_rmse"] < 0.2 * scores["odo"]["ate_rmse"]
+    assert scores["fht"]["map_error"] < 0.05 and scores["fht"]["map_coverage"] > 0.8
+
+
+def test_slam_bad_log_leaves_no_output(tmp_path):
+    bad = tmp_path / "bad.clf"
+    bad.write_text("FLASER 3 1.0 2.0 3.0 0 0 0 0 0 0 1.0 host 1.0\nFLASER 3 1.0 nan?\n")
+    out = tmp_path / "t.txt"
+    r = run("slam", str(bad), "--trajectory", str(out))
+    assert r.returncode == 2 and "bad.clf:2:" in r.stderr and "Traceback" not in r.stderr
+    assert not out.exists()
+
+
+def test_slam_unknown_method_is_a_usage_error(tmp_path):
+    r = run("slam", "x.clf", "--method", "ekf9", "--trajectory", str(tmp_path / "t"))
+    assert r.returncode == 2 and "invalid choice" in r.stderr

@@ -102,7 +102,7 @@ def test_bad_world_json_names_the_file(tmp_path):
     assert r.returncode == 2 and "w.json" in r.stderr
 
 
-def test_reproduce_writes_figures_1_to_5(tmp_path):
+def test_reproduce_writes_figures_1_to_14(tmp_path):
     r = run("reproduce", "--out", str(tmp_path))
     assert r.returncode == 0, r.stderr
     names = sorted(p.name for p in tmp_path.glob("*.png"))
@@ -112,6 +112,12 @@ def test_reproduce_writes_figures_1_to_5(tmp_path):
         "fig03_extended_points.png",
         "fig04_clusters.png",
         "fig05_lines.png",
+        "fig06_line_attributes.png",
+        "fig07_10_similarity.png",
+        "fig11_merging.png",
+        "fig12_pioneer.png",
+        "fig13_environment_map.png",
+        "fig14_slam_result.png",
     ]
     assert all((tmp_path / n).stat().st_size > 20_000 for n in names)  # real pictures
 

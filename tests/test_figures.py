@@ -1,0 +1,124 @@
+"""The paper's sketches of Loop 2 (Figs. 6-12): the examples behind them and that they draw."""
+
+from __future__ import annotations
+
+import matplotlib
+
+matplotlib.use("Agg")
+
+import matplotlib.pyplot as plt
+import numpy as np
+import pytest
+from matplotlib.figure import Figure
+
+from fhslam import figures
+from fhslam.matching import MatchParams, merge, similarity
+
+# (a) same direction, (b) angle, (c) distance, (d) overlap -- as the paper's text says:
+# "Fig. 8 satisfies condition (d) and does not satisfy condition (c), Fig. 9 does not satisfy
+# condition (b) and (d), Fig. 10 does not satisfy condition (b) and (c)".
+CAPTION_CONDITIONS = {
+    7: (True, True, True, True),
+    8: (True, True, False, True),
+    9: (True, False, True, False),
+    10: (True, False, False, True),
+}
+
+
+@pytest.mark.parametrize("k", sorted(CAPTION_CONDITIONS))
+def test_similarity_examples_match_the_captions(k):
+    ref, new, pose = figures.similarity_examples()[k]
+    sim = similarity(ref, new, MatchParams(), pose=pose)
+    got = (sim.same_direction, sim.angle_ok, sim.distance_ok, sim.overlap_ok)
+    assert got == CAPTION_CONDITIONS[k]
+    assert sim.similar == (k == 7)
+    # the conditions are symmetric, so the verdict does not depend on which line is "new"
+    rev = similarity(new, ref, MatchParams(), pose=pose)
+    assert (rev.same_direction, rev.angle_ok, rev.distance_ok, rev.overlap_ok) == got
+
+
+def test_similarity_examples_share_one_pose_and_margins_are_clear():
+    ex = figures.similarity_examples()
+    assert sorted(ex) == [7, 8, 9, 10]
+    assert all(pose == figures.SIMILARITY_POSE for _, _, pose in ex.values())
+    p = MatchParams()
+    for ref, new, pose in ex.values():
+        s = similarity(ref, new, p, pose=pose)
+        # no example sits on a threshold, so small numeric changes cannot flip a condition
+        assert abs(s.angle_deg - p.max_angle_deg) > 1.0
+        assert abs(s.distance - p.max_distance) > 0.01
+        assert abs(s.overlap - p.min_overlap) > 0.1
+        assert ref.observed_from(pose).dir == new.observed_from(pose).dir == 1
+
+
+def test_line_attributes_example_is_seen_from_the_origin_side():
+    line, pose = figures.line_attributes_example()
+    x, y, _ = pose
+    s = line.rho - x * np.cos(line.theta) - y * np.sin(line.theta)  # paper: dir = sign(s)
+    assert line.dir == np.sign(s) == 1
+    assert line.d == pytest.approx(abs(s))
+    assert line.n == 9
+    assert line.rho == pytest.approx(2.5, abs=0.03)
+    assert np.degrees(line.theta) == pytest.approx(60.0, abs=1.0)
+    assert line.length == pytest.approx(np.linalg.norm(line.ep - line.sp))
+
+
+def test_merged_line_spans_from_c_to_f():
+    ef, ab = figures.merging_example()
+    merged = merge(ef, ab)
+    assert similarity(ef, ab, pose=(2.5, 0.0, np.pi / 2)).similar
+    # C is A projected onto EF's line (y = 1); F is EF's end point.
+    C, F = np.array([-0.5, 1.0]), np.array([4.0, 1.0])
+    np.testing.assert_allclose(ef.sp, [1.0, 1.0], atol=1e-9)
+    np.testing.assert_allclose(ef.ep, F, atol=1e-9)
+    u = ef.ep - ef.sp
+    u /= np.linalg.norm(u)
+    assert merged.sp @ u == pytest.approx(C @ u, abs=2e-3)  # extended to C ...
+    assert merged.ep @ u == pytest.approx(F @ u, abs=2e-3)  # ... and still reaching F
+    assert merged.length == pytest.approx(4.5, abs=2e-3)  # |CF|
+    # the refit keeps the merged line within a few centimetres of EF's line
+    assert abs(merged.sp[1] - C[1]) < 0.05 and abs(merged.ep[1] - F[1]) < 0.05
+    assert merged.n == ef.n + ab.n
+
+
+@pytest.mark.parametrize(
+    ("make", "number"),
+    [
+        (figures.fig06_line_attributes, "Fig. 6"),
+        (figures.fig07_to_10_similarity, "Figs. 7–10"),
+        (figures.fig11_merging, "Fig. 11"),
+        (figures.fig12_pioneer, "Fig. 12"),
+    ],
+)
+def test_new_figures_draw_and_close(make, number):
+    fig = make()
+    try:
+        assert isinstance(fig, Figure)
+        assert fig.axes
+        titles = [fig.get_suptitle()]
+        titles += [ax.get_title() for ax in fig.axes]
+        assert any(t.startswith(number + "  ") for t in titles)
+        fig.canvas.draw()
+    finally:
+        plt.close(fig)
+    assert not plt.fignum_exists(fig.number)
+
+
+def test_similarity_figure_prints_each_verdict():
+    fig = figures.fig07_to_10_similarity()
+    try:
+        assert len(fig.axes) == 4
+        texts = [t.get_text() for ax in fig.axes for t in ax.texts]
+        assert texts.count("→ similar") == 1 and texts.count("→ not similar") == 3
+    finally:
+        plt.close(fig)
+
+
+def test_figures_are_deterministic():
+    a, b = figures.similarity_examples(), figures.similarity_examples()
+    for k in a:
+        for la, lb in zip(a[k][:2], b[k][:2], strict=True):
+            np.testing.assert_array_equal(la.sp, lb.sp)
+            np.testing.assert_array_equal(la.ep, lb.ep)
+    (l1, p1), (l2, p2) = figures.line_attributes_example(), figures.line_attributes_example()
+    assert p1 == p2 and l1.rho == l2.rho and l1.theta == l2.theta

@@ -133,7 +133,7 @@ def run_slam_bench(world: str = "paper", seed: int = 0, repeats: int = 3) -> lis
 
     log = simulate(load_world(world), seed=seed)
     rows = []
-    for method in ("fht", "odometry"):
+    for method in ("fht",):
         run_slam(log, method)  # warm-up (JIT, caches)
         t = _median_time(lambda m=method: run_slam(log, m), repeats)
         rows.append(SlamBenchRow(method, len(log) / t, t, len(log)))

@@ -26,7 +26,7 @@ from numpy.typing import ArrayLike, NDArray
 from tqdm.auto import tqdm
 
 from fhslam.extraction import ExtractionParams, extract_lines, scan_to_points
-from fhslam.geometry import as_pose, compose, relative, wrap_angle
+from fhslam.geometry import as_pose, compose, relative, signed_distance, wrap_angle
 from fhslam.lines import Line, transform_lines
 from fhslam.matching import MatchParams, match_lines, merge
 
@@ -56,6 +56,13 @@ class SlamParams:
         association and the odometry prediction is kept.
     max_rotation_deg : float
         Largest accepted heading correction per step, degrees.
+    robust_scale : float or None
+        Huber scale of the calibration's endpoint residuals, metres (see
+        :func:`calibrate_pose`).
+    max_merge_residual : float
+        After calibration, a matched line is merged into its reference line only if both of
+        its endpoints lie within this distance of it, metres; a worse pair was a wrong match
+        and would corrupt the map.
     """
 
     extraction: ExtractionParams = field(default_factory=ExtractionParams)
@@ -66,6 +73,8 @@ class SlamParams:
     min_eigen_ratio: float = 0.05
     max_correction: float = 0.5
     max_rotation_deg: float = 10.0
+    robust_scale: float | None = 0.02
+    max_merge_residual: float = 0.05
 
 
 @dataclass(frozen=True)
@@ -85,6 +94,7 @@ def calibrate_pose(
     pose: ArrayLike,
     iterations: int = 3,
     min_eigen_ratio: float = 0.05,
+    robust_scale: float | None = 0.02,
 ) -> Calibration:
     """The robot pose that best lays the observed lines onto their reference lines.
 
@@ -110,6 +120,15 @@ def calibrate_pose(
         ``(observed index, reference index)`` of the matched lines.
     pose : array-like, shape (3,)
         The predicted pose ``world_T_robot``.
+    iterations : int
+        Gauss-Newton rounds.
+    min_eigen_ratio : float
+        Corridor test threshold (see above).
+    robust_scale : float or None
+        Huber scale of the endpoint residuals, metres: a residual ``r`` beyond it is
+        down-weighted by ``robust_scale / |r|`` (iteratively reweighted least squares), so one
+        wrong pair (e.g. a line fitted across a shallow corner) cannot drag the pose. ``None``
+        gives plain least squares.
 
     Returns
     -------
@@ -129,7 +148,7 @@ def calibrate_pose(
     th_r = np.repeat([r.theta for r in refs], 2)
     rho_r = np.repeat([r.rho for r in refs], 2)
     n_r = np.column_stack([np.cos(th_r), np.sin(th_r)])
-    w = np.repeat([min(o.n, r.n) for o, r in zip(obs, refs, strict=True)], 2).astype(float)
+    w0 = np.repeat([min(o.n, r.n) for o, r in zip(obs, refs, strict=True)], 2).astype(float)
     constrained = (False, False)
     for _ in range(iterations):
         c, s_ = np.cos(x[2]), np.sin(x[2])
@@ -137,6 +156,11 @@ def calibrate_pose(
         p_w = rel + x[:2]
         r = rho_r - np.einsum("ij,ij->i", n_r, p_w)  # signed distance to the reference
         jac = np.column_stack([n_r, n_r[:, 1] * rel[:, 0] - n_r[:, 0] * rel[:, 1]])
+        w = (
+            w0
+            if robust_scale is None
+            else w0 * np.minimum(1.0, robust_scale / np.maximum(np.abs(r), 1e-12))
+        )
         h = (jac * w[:, None]).T @ jac
         # Position information left once the heading is free (Schur complement): its
         # weak eigen-direction, if any, is the corridor's axis.
@@ -240,7 +264,13 @@ class FastHoughSLAM:
             match = match_lines(world, self.references, p.matching, pose)
             pairs = [(i, int(j)) for i, j in enumerate(match) if j >= 0]
             cal = calibrate_pose(
-                observed, self.references, pairs, pose, p.iterations, p.min_eigen_ratio
+                observed,
+                self.references,
+                pairs,
+                pose,
+                p.iterations,
+                p.min_eigen_ratio,
+                p.robust_scale,
             )
             if (
                 np.hypot(*cal.correction[:2]) > p.max_correction
@@ -255,7 +285,10 @@ class FastHoughSLAM:
         match = match_lines(world, self.references, p.matching, pose)
         for ln, j in zip(world, match, strict=True):
             if j >= 0:
-                self.references[j] = merge(self.references[j], ln)
+                ref = self.references[j]
+                off = np.abs(signed_distance(np.array([ln.sp, ln.ep]), ref.rho, ref.theta))
+                if off.max() <= p.max_merge_residual:
+                    self.references[j] = merge(ref, ln)
         added = self._add_references(observed, pose, match)
         n_matched = int((match >= 0).sum())
         return StepResult(pose.copy(), len(observed), n_matched, added, corrected)

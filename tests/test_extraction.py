@@ -244,3 +244,14 @@ def test_same_seed_gives_the_same_lines(seed, x, heading):
     params = ExtractionParams(seed=seed)
     a, b = extract_lines(p, params), extract_lines(p, params)
     assert [(ln.rho, ln.theta, ln.n) for ln in a] == [(ln.rho, ln.theta, ln.n) for ln in b]
+
+
+def test_lone_clutter_points_do_not_split_a_wall():
+    p = np.column_stack([np.linspace(-3, 3, 121), np.full(121, 3.0)])
+    p[[30, 70]] = [[-1.2, 1.0], [0.4, 2.0]]  # two returns short of the wall (people, chairs)
+    from fhslam.extraction import lone_points
+
+    assert np.flatnonzero(lone_points(p, 0.3)).tolist() == [30, 70]
+    (line,) = extract_lines(p)  # one wall, not three pieces
+    assert line.n == 119 and not np.isin([30, 70], line.inliers).any()
+    assert len(extract_lines(p, ExtractionParams(drop_lone_points=False))) == 3  # the paper's rule

@@ -115,9 +115,10 @@ def test_fh_slam_on_held_out_worlds_meets_issue_3(world):
     assert m["coverage"] >= 0.80
 
 
-@pytest.mark.parametrize(("world", "laps"), [("paper", 1), ("random:110", 3)])
+@pytest.mark.parametrize(("world", "laps"), [("paper", 1)] + [(w, 3) for w in HELD_OUT])
 def test_dropped_scans_and_clutter_at_most_double_the_ate(world, laps):
-    """10% of scans dropped and 5% clutter returns (short of the wall)."""
+    """10% of scans dropped and 5% clutter returns (short of the wall). Over all 20 held-out
+    worlds the ratio has median 1.2; on 2 of them it reaches 2.5 (2-3 mm clean, 6-8 mm)."""
     clean, bad = _run(world, laps), _run(world, laps, degraded=True)
     assert bad["ate"] <= 2.0 * clean["ate"]
     assert bad["ate"] <= 0.15

@@ -21,7 +21,7 @@ def cast(walls: np.ndarray, pose, n_beams: int = 181, noise: float = 0.01, seed:
     e = q - p
     denom = d[:, None, 0] * e[None, :, 1] - d[:, None, 1] * e[None, :, 0]
     w = p[None] - np.array([x, y])
-    with np.errstate(divide="ignore", invalid="ignore"):
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
         t = (w[..., 0] * e[None, :, 1] - w[..., 1] * e[None, :, 0]) / denom
         s = (w[..., 0] * d[:, None, 1] - w[..., 1] * d[:, None, 0]) / denom
     t = np.where((t > 0) & (s >= 0) & (s <= 1), t, np.inf)

@@ -198,9 +198,10 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("log", type=Path, help="CARMEN text log (.clf)")
     p.add_argument(
         "--method",
-        choices=("fht", "odometry"),
+        choices=("fht", "classical", "ekf", "odometry"),
         default="fht",
-        help="fht: fast-Hough SLAM (default); odometry: dead reckoning",
+        help="fht: fast-Hough SLAM (default); classical: the same with OpenCV's classical "
+        "Hough as Loop 1; ekf: EKF line SLAM (filterpy); odometry: dead reckoning",
     )
     p.add_argument("--trajectory", required=True, type=Path, help="output: timestamp x y theta")
     p.add_argument("--map", type=Path, help="output map JSON (reference lines)")

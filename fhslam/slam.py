@@ -18,8 +18,8 @@ parallel) the pose is not corrected along it (see :func:`calibrate_pose`).
 
 from __future__ import annotations
 
-from collections.abc import Sequence
-from dataclasses import dataclass, field
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -59,6 +59,11 @@ class SlamParams:
     robust_scale : float or None
         Huber scale of the calibration's endpoint residuals, metres (see
         :func:`calibrate_pose`).
+    extractor : callable or None
+        Loop 1 to use instead of the fast Hough transform: ``points (N, 2) -> list[Line]``
+        (e.g. :func:`fhslam.baselines.hough_opencv_pointset`, to measure what the fast
+        transform contributes). ``None``: :func:`fhslam.extraction.extract_lines` with
+        ``extraction``.
     max_merge_residual : float
         After calibration, a matched line is merged into its reference line only if both of
         its endpoints lie within this distance of it, metres; a worse pair was a wrong match
@@ -75,6 +80,7 @@ class SlamParams:
     max_rotation_deg: float = 10.0
     robust_scale: float | None = 0.02
     max_merge_residual: float = 0.05
+    extractor: Callable[[NDArray[np.float64]], list[Line]] | None = None
 
 
 @dataclass(frozen=True)
@@ -254,7 +260,7 @@ class FastHoughSLAM:
         if ranges is None:
             return StepResult(pose.copy(), 0, 0, 0, False)
         points, _ = scan_to_points(ranges, angles, max_range=max_range)
-        observed = extract_lines(points, p.extraction)
+        observed = p.extractor(points) if p.extractor else extract_lines(points, p.extraction)
         if not self.references:
             added = self._add_references(observed, pose, np.full(len(observed), -1))
             return StepResult(pose.copy(), len(observed), 0, added, False)
@@ -321,12 +327,18 @@ class FastHoughSLAM:
         )
 
 
+METHODS = ("fht", "classical", "ekf", "odometry")
+"""SLAM methods: FH-SLAM, FH-SLAM with OpenCV's classical Hough as Loop 1, the EKF
+line-SLAM baseline, and dead reckoning."""
+
+
 def run_slam(
     log, method: str = "fht", params: SlamParams | None = None, progress: bool = False
 ) -> SlamResult:
-    """Run a SLAM method on a log: ``"fht"`` (FH-SLAM) or ``"odometry"`` (dead reckoning).
+    """Run a SLAM method (one of :data:`METHODS`) over a log.
 
-    FH-SLAM starts at the first odometry pose, which a simulated log sets to the true start.
+    Every method starts at the first odometry pose, which a simulated log sets to the true
+    start ("suppose the initial localization of mobile robot is correct").
     """
     if method == "odometry":
         return SlamResult(
@@ -334,4 +346,13 @@ def run_slam(
         )
     if method == "fht":
         return FastHoughSLAM(params).run(log, progress=progress)
-    raise ValueError(f"unknown SLAM method {method!r}; choose 'fht' or 'odometry'")
+    if method == "classical":
+        from fhslam.baselines import hough_opencv_pointset
+
+        p = replace(params or SlamParams(), extractor=hough_opencv_pointset)
+        return FastHoughSLAM(p).run(log, progress=progress)
+    if method == "ekf":
+        from fhslam.baselines.ekf_slam import EKFLineSLAM
+
+        return EKFLineSLAM().run(log, progress=progress)
+    raise ValueError(f"unknown SLAM method {method!r}; choose one of {', '.join(METHODS)}")

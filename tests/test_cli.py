@@ -279,3 +279,32 @@ def test_slam_bad_log_leaves_no_output(tmp_path):
 def test_slam_unknown_method_is_a_usage_error(tmp_path):
     r = run("slam", "x.clf", "--method", "ekf9", "--trajectory", str(tmp_path / "t"))
     assert r.returncode == 2 and "invalid choice" in r.stderr
+
+
+@pytest.mark.parametrize("method", ["ekf", "classical"])
+def test_slam_methods_through_the_command_line(tmp_path, method):
+    log, truth = tmp_path / "p.clf", tmp_path / "truth.txt"
+    main(
+        [
+            "simulate",
+            "random:107",
+            "--odometry",
+            "drifting",
+            "--laps",
+            "3",
+            "--log",
+            str(log),
+            "--truth",
+            str(truth),
+        ]
+    )
+    traj, mp = tmp_path / "t.txt", tmp_path / "m.json"
+    r = run(
+        "slam", str(log), "--method", method, "--trajectory", str(traj), "--map", str(mp), "--quiet"
+    )
+    assert r.returncode == 0, r.stderr
+    r = run("evaluate", str(traj), "--truth", str(truth), "--json")
+    odo = run("slam", str(log), "--method", "odometry", "--trajectory", str(tmp_path / "o"))
+    assert odo.returncode == 0
+    o = json.loads(run("evaluate", str(tmp_path / "o"), "--truth", str(truth), "--json").stdout)
+    assert json.loads(r.stdout)["ate_rmse"] <= 0.5 * o["ate_rmse"]

@@ -1,0 +1,359 @@
+"""EKF line SLAM: the Kalman-filter alternative the paper's introduction lists, as a baseline.
+
+State ``[x, y, θ, α₁, r₁, α₂, r₂, ...]``: the robot pose and each landmark line in Hessian
+form in the world (``r >= 0``). Built on :class:`filterpy.kalman.ExtendedKalmanFilter`:
+
+- **predict** from the odometry increment ``u = odo_{k-1} ⊖ odo_k`` with a noise model growing
+  with the distance and the turn (:class:`EKFParams`);
+- **measure** each line extracted by the same Loop 1 as FH-SLAM, in the robot frame:
+  ``ẑ = [α − θ, r − (x cos α + y sin α)]`` (:func:`predict_measurement`, Jacobian
+  :func:`measurement_jacobian`), flipped to ``[α − θ + π, −r̂]`` when ``r̂ < 0`` so the
+  prediction has the measurement's form; angles compared through :func:`residual`;
+- each line's covariance from its least-squares fit (Arras & Siegwart 1997; Pfister et al.
+  2003): :func:`line_covariance`;
+- **associate** by Mahalanobis distance with a χ² gate (2 dof), nearest first;
+- **add** unmatched long lines as new landmarks by growing ``x``, ``P`` and the filter's
+  dimension — filterpy fixes ``dim_x`` at construction, so :meth:`EKFLineSLAM._grow` builds a
+  larger filter and copies the state over; it is the only place the dimension changes.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+from filterpy.kalman import ExtendedKalmanFilter
+from numpy.typing import ArrayLike, NDArray
+from tqdm.auto import tqdm
+
+from fhslam.extraction import ExtractionParams, extract_lines, scan_to_points
+from fhslam.geometry import as_pose, compose, relative, wrap_angle
+from fhslam.lines import Line
+
+CHI2_2DOF_99 = 9.2103
+"""99 % quantile of the χ² distribution with 2 degrees of freedom."""
+
+
+@dataclass(frozen=True)
+class EKFParams:
+    """Parameters of the EKF line-SLAM baseline.
+
+    Attributes
+    ----------
+    extraction : ExtractionParams
+        Loop 1, the same as FH-SLAM's.
+    trans_noise : float
+        Standard deviation of the odometry's distance error per metre driven.
+    rot_noise : float
+        Standard deviation of the odometry's turn error per radian turned.
+    rot_per_metre : float
+        Standard deviation of the heading error per metre driven, rad/m.
+    min_std : tuple of float
+        Floor of the motion noise per step: (metres, radians).
+    range_std : float
+        Floor of a line point's noise, metres (the fit's rms is used when larger).
+    gate : float
+        Mahalanobis gate for data association (χ², 2 dof).
+    new_gate : float
+        A line whose nearest landmark is farther than this (χ²) starts a new landmark;
+        between ``gate`` and ``new_gate`` it is ambiguous and ignored.
+    min_landmark_length : float
+        Shortest line (metres) that starts a landmark.
+    min_landmark_points : int
+        Fewest points for a line to start a landmark.
+    """
+
+    extraction: ExtractionParams = field(default_factory=ExtractionParams)
+    trans_noise: float = 0.05
+    rot_noise: float = 0.05
+    rot_per_metre: float = 0.02
+    min_std: tuple[float, float] = (0.002, 0.002)
+    range_std: float = 0.01
+    gate: float = CHI2_2DOF_99
+    new_gate: float = 50.0
+    min_landmark_length: float = 0.8
+    min_landmark_points: int = 10
+
+
+# --------------------------------------------------------------------------- models
+
+
+def predict_measurement(x: NDArray, j: int) -> NDArray[np.float64]:
+    """ẑ of landmark ``j`` seen from the robot state ``x[:3]``: ``[α − θ, r − (x cos α +
+    y sin α)]``, flipped to ``[α − θ + π, −r̂]`` when ``r̂ < 0``; the angle wrapped to [0, 2π)."""
+    a, r = x[3 + 2 * j], x[4 + 2 * j]
+    rr = r - (x[0] * np.cos(a) + x[1] * np.sin(a))
+    za = a - x[2]
+    if rr < 0:
+        za, rr = za + np.pi, -rr
+    return np.array([np.mod(za, 2 * np.pi), rr])
+
+
+def measurement_jacobian(x: NDArray, j: int) -> NDArray[np.float64]:
+    """∂ẑ/∂x of :func:`predict_measurement`, shape (2, len(x))."""
+    a, r = x[3 + 2 * j], x[4 + 2 * j]
+    rr = r - (x[0] * np.cos(a) + x[1] * np.sin(a))
+    h = np.zeros((2, len(x)))
+    h[0, 2] = -1.0
+    h[0, 3 + 2 * j] = 1.0
+    h[1, 0], h[1, 1] = -np.cos(a), -np.sin(a)
+    h[1, 3 + 2 * j] = x[0] * np.sin(a) - x[1] * np.cos(a)
+    h[1, 4 + 2 * j] = 1.0
+    if rr < 0:
+        h[1] = -h[1]
+    return h
+
+
+def residual(z: NDArray, zhat: NDArray) -> NDArray[np.float64]:
+    """``z − ẑ`` for stacked line measurements ``[α, r, α, r, ...]``: angles wrapped, and a
+    line through the robot (``r ≈ 0``, where ``(α, r)`` and ``(α + π, −r)`` are the same line)
+    compared in the form closest to the prediction, so it never looks π off."""
+    z = np.asarray(z, dtype=float).reshape(-1, 2)
+    zh = np.asarray(zhat, dtype=float).reshape(-1, 2)
+    da = wrap_angle(z[:, 0] - zh[:, 0])
+    dr = z[:, 1] - zh[:, 1]
+    flip = np.abs(da) > np.pi / 2
+    da = np.where(flip, wrap_angle(z[:, 0] + np.pi - zh[:, 0]), da)
+    dr = np.where(flip, -z[:, 1] - zh[:, 1], dr)
+    return np.column_stack([da, dr]).ravel()
+
+
+def line_covariance(points: ArrayLike, line: Line, sigma_floor: float = 0.01) -> NDArray:
+    """Covariance of a fitted line's ``(α, r)`` from its inlier points (Arras & Siegwart 1997).
+
+    With points of isotropic noise σ (the fit's rms, at least ``sigma_floor``), spread along
+    the line with coordinates ``t`` (``t̄`` their mean, measured from the foot of the
+    perpendicular): ``var α = σ² / Σ(t − t̄)²``, ``var r = σ²/n + t̄² var α``,
+    ``cov(α, r) = t̄ var α``.
+
+    Parameters
+    ----------
+    points : array-like, shape (N, 2)
+        The scan's points (in the frame of ``line``); ``line.inliers`` index them.
+    """
+    p = np.asarray(points, dtype=float)[line.inliers]
+    u = np.array([-np.sin(line.theta), np.cos(line.theta)])
+    t = p @ u
+    s2 = max(line.rms, sigma_floor) ** 2
+    spread = max(float(np.sum((t - t.mean()) ** 2)), 1e-6)
+    var_a = s2 / spread
+    tb = float(t.mean())
+    return np.array([[var_a, tb * var_a], [tb * var_a, s2 / len(p) + tb**2 * var_a]])
+
+
+class _MotionEKF(ExtendedKalmanFilter):
+    """filterpy's EKF with the nonlinear motion ``x ⊕ u`` for the robot part of the state."""
+
+    def predict_x(self, u=0):
+        self.x[:3] = compose(self.x[:3], u)
+
+
+# --------------------------------------------------------------------------- the filter
+
+
+class EKFLineSLAM:
+    """EKF line SLAM on filterpy, driven like :class:`fhslam.slam.FastHoughSLAM`."""
+
+    def __init__(self, params: EKFParams | None = None, initial_pose: ArrayLike | None = None):
+        self.params = params or EKFParams()
+        self.ekf: _MotionEKF | None = None
+        self._init_pose = None if initial_pose is None else as_pose(initial_pose)
+        self._last_odometry: NDArray | None = None
+        self._extent: list[list[float]] = []  # per landmark: [t_min, t_max] along the line
+        self._support: list[int] = []
+
+    @property
+    def pose(self) -> NDArray[np.float64]:
+        return self.ekf.x[:3].copy()
+
+    @property
+    def n_landmarks(self) -> int:
+        return 0 if self.ekf is None else (self.ekf.dim_x - 3) // 2
+
+    def _start(self, pose: NDArray) -> None:
+        self.ekf = _MotionEKF(dim_x=3, dim_z=2)
+        self.ekf.x = pose.astype(float).copy()
+        self.ekf.P = np.eye(3) * 1e-9  # "suppose the initial localization is correct"
+
+    def _grow(self, landmark: NDArray, cov_rows: NDArray, cov_lm: NDArray) -> None:
+        """Append one landmark: the only place the filter's dimension changes.
+
+        ``cov_rows`` (2, n) is the landmark's covariance with the current state and ``cov_lm``
+        (2, 2) its own; a new :class:`filterpy.kalman.ExtendedKalmanFilter` of dimension
+        ``n + 2`` takes over ``x`` and ``P`` (filterpy sizes ``_I``, ``F``, ``Q`` at
+        construction).
+        """
+        old = self.ekf
+        n = old.dim_x
+        new = _MotionEKF(dim_x=n + 2, dim_z=2)
+        new.x = np.concatenate([old.x, landmark])
+        p = np.zeros((n + 2, n + 2))
+        p[:n, :n] = old.P
+        p[n:, :n] = cov_rows
+        p[:n, n:] = cov_rows.T
+        p[n:, n:] = cov_lm
+        new.P = p
+        self.ekf = new
+
+    def predict(self, odometry: ArrayLike) -> None:
+        odo = as_pose(odometry, "odometry")
+        if self.ekf is None:
+            self._start(self._init_pose if self._init_pose is not None else odo)
+            self._last_odometry = odo
+            return
+        u = relative(self._last_odometry, odo)
+        self._last_odometry = odo
+        pr = self.params
+        dist, turn = float(np.hypot(u[0], u[1])), abs(float(u[2]))
+        s_t = pr.trans_noise * dist + pr.min_std[0]
+        s_r = pr.rot_noise * turn + pr.rot_per_metre * dist + pr.min_std[1]
+        th = self.ekf.x[2]
+        c, s = np.cos(th), np.sin(th)
+        n = self.ekf.dim_x
+        f = np.eye(n)
+        f[0, 2] = -s * u[0] - c * u[1]
+        f[1, 2] = c * u[0] - s * u[1]
+        ju = np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
+        q = np.zeros((n, n))
+        q[:3, :3] = ju @ np.diag([s_t**2, s_t**2, s_r**2]) @ ju.T
+        self.ekf.F, self.ekf.Q = f, q
+        self.ekf.predict(u=u)
+
+    def _associate(self, lines: list[Line], covs: list[NDArray]) -> list[tuple[int, float]]:
+        """Nearest landmark by Mahalanobis distance (χ²) for each line, and that distance."""
+        x, p = self.ekf.x, self.ekf.P
+        out = []
+        for ln, r in zip(lines, covs, strict=True):
+            best, best_d2 = -1, np.inf
+            z = np.array([ln.theta, ln.rho])
+            for j in range(self.n_landmarks):
+                h = measurement_jacobian(x, j)
+                s = h @ p @ h.T + r
+                y = residual(z, predict_measurement(x, j))
+                try:
+                    d2 = float(y @ np.linalg.solve(s, y))
+                except np.linalg.LinAlgError:
+                    continue
+                if d2 < best_d2:
+                    best, best_d2 = j, d2
+            out.append((best, best_d2))
+        return out
+
+    def update(self, lines: list[Line], points: NDArray) -> tuple[int, int]:
+        """Associate, update with all matched lines at once, add new landmarks.
+
+        Returns (matched, added)."""
+        pr = self.params
+        covs = [line_covariance(points, ln, pr.range_std) for ln in lines]
+        assoc = self._associate(lines, covs)
+        matched = [(i, j) for i, (j, d2) in enumerate(assoc) if j >= 0 and d2 <= pr.gate]
+        if matched:
+            z = np.concatenate([[lines[i].theta, lines[i].rho] for i, _ in matched])
+            r = np.zeros((len(z), len(z)))
+            for k, (i, _) in enumerate(matched):
+                r[2 * k : 2 * k + 2, 2 * k : 2 * k + 2] = covs[i]
+            idx = [j for _, j in matched]
+            self._safe_update(z, r, idx)
+            for i, j in matched:
+                self._extend(j, lines[i])
+        added = 0
+        for i, (j, d2) in enumerate(assoc):
+            ln = lines[i]
+            long_enough = ln.length >= pr.min_landmark_length and ln.n >= pr.min_landmark_points
+            if (j < 0 or d2 > pr.new_gate) and long_enough:
+                self._add_landmark(ln, covs[i])
+                added += 1
+        return len(matched), added
+
+    def _safe_update(self, z: NDArray, r: NDArray, idx: list[int]) -> None:
+        """filterpy's update over the stacked measurements; skipped (state unchanged) when the
+        innovation covariance is singular or the result would not be finite."""
+        x0, p0 = self.ekf.x.copy(), self.ekf.P.copy()
+
+        def hj(x):
+            return np.vstack([measurement_jacobian(x, j) for j in idx])
+
+        def hx(x):
+            return np.concatenate([predict_measurement(x, j) for j in idx])
+
+        try:
+            self.ekf.update(z, hj, hx, R=r, residual=residual)
+        except np.linalg.LinAlgError:
+            self.ekf.x, self.ekf.P = x0, p0
+            return
+        if not (np.all(np.isfinite(self.ekf.x)) and np.all(np.isfinite(self.ekf.P))):
+            self.ekf.x, self.ekf.P = x0, p0
+            return
+        self.ekf.x[2] = wrap_angle(self.ekf.x[2])
+        lm = self.ekf.x[3:].reshape(-1, 2)
+        neg = lm[:, 1] < 0  # keep r >= 0: (α, r) == (α + π, −r)
+        lm[neg, 0] += np.pi
+        lm[neg, 1] *= -1
+        lm[:, 0] = np.mod(lm[:, 0], 2 * np.pi)
+
+    def _add_landmark(self, ln: Line, cov_z: NDArray) -> None:
+        x, y, th = self.ekf.x[:3]
+        a = ln.theta + th
+        r = ln.rho + x * np.cos(a) + y * np.sin(a)
+        flip = r < 0
+        if flip:
+            a, r = a + np.pi, -r
+        a = np.mod(a, 2 * np.pi)
+        dr_dth = -x * np.sin(a) + y * np.cos(a)
+        if flip:
+            dr_dth = -dr_dth
+        gx = np.array([[0.0, 0.0, 1.0], [np.cos(a), np.sin(a), dr_dth]])
+        gz = np.array([[1.0, 0.0], [dr_dth, -1.0 if flip else 1.0]])
+        p = self.ekf.P
+        rows = gx @ p[:3, :]
+        cov_lm = gx @ p[:3, :3] @ gx.T + gz @ cov_z @ gz.T
+        self._grow(np.array([a, r]), rows, cov_lm)
+        self._extent.append([np.inf, -np.inf])
+        self._support.append(0)
+        self._extend(self.n_landmarks - 1, ln)
+
+    def _extend(self, j: int, ln: Line) -> None:
+        """Grow landmark j's known extent with the observed segment (for the map output)."""
+        w = ln.transformed(self.ekf.x[:3])
+        a = self.ekf.x[3 + 2 * j]
+        u = np.array([-np.sin(a), np.cos(a)])
+        t = [float(w.sp @ u), float(w.ep @ u)]
+        e = self._extent[j]
+        e[0], e[1] = min(e[0], *t), max(e[1], *t)
+        self._support[j] += ln.n
+
+    def step(self, ranges, angles, odometry, max_range=None) -> tuple[int, int]:
+        """Predict from odometry and, if there is a scan, update; returns (matched, added)."""
+        self.predict(odometry)
+        if ranges is None:
+            return 0, 0
+        points, _ = scan_to_points(ranges, angles, max_range=max_range)
+        lines = extract_lines(points, self.params.extraction)
+        if not lines:
+            return 0, 0
+        return self.update(lines, points)
+
+    def landmarks(self) -> list[Line]:
+        """The map: each landmark line over the extent it was seen."""
+        out = []
+        for j in range(self.n_landmarks):
+            a, r = self.ekf.x[3 + 2 * j : 5 + 2 * j]
+            n = np.array([np.cos(a), np.sin(a)])
+            u = np.array([-n[1], n[0]])
+            lo, hi = self._extent[j]
+            sp, ep = r * n + lo * u, r * n + hi * u
+            out.append(
+                Line(rho=float(r), theta=float(a), n=self._support[j], length=float(hi - lo),
+                     sp=sp, ep=ep)
+            )  # fmt: skip
+        return out
+
+    def run(self, log, progress: bool = False):
+        """Run over a whole log; returns a :class:`fhslam.slam.SlamResult`."""
+        from fhslam.slam import SlamResult
+
+        poses = []
+        for k in tqdm(range(len(log.timestamps)), desc="EKF", unit="scan", disable=not progress):
+            self.step(log.ranges[k], log.angles, log.odometry[k], log.max_range)
+            poses.append(self.pose)
+        return SlamResult(np.asarray(log.timestamps, float), np.array(poses), self.landmarks(), [])

@@ -1,0 +1,132 @@
+"""The EKF line-SLAM baseline: models, Jacobians, bad input, and accuracy on held-out worlds."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from fhslam.baselines.ekf_slam import (
+    EKFLineSLAM,
+    line_covariance,
+    measurement_jacobian,
+    predict_measurement,
+    residual,
+)
+from fhslam.geometry import inverse
+from fhslam.lines import line_from_points
+
+
+def numeric_jacobian(x, j, eps=1e-6):
+    h = np.zeros((2, len(x)))
+    for k in range(len(x)):
+        d = np.zeros(len(x))
+        d[k] = eps
+        h[:, k] = residual(predict_measurement(x + d, j), predict_measurement(x - d, j)) / (2 * eps)
+    return h
+
+
+@settings(max_examples=200, deadline=None, derandomize=True)
+@given(
+    pose=st.tuples(st.floats(-10, 10), st.floats(-10, 10), st.floats(-np.pi, np.pi)),
+    lm=st.tuples(st.floats(0, 2 * np.pi), st.floats(0.05, 15)),
+    other=st.tuples(st.floats(0, 2 * np.pi), st.floats(0.05, 15)),
+)
+def test_measurement_jacobian_matches_finite_differences(pose, lm, other):
+    x = np.array([*pose, *other, *lm])  # landmark 1 is the one measured
+    zhat = predict_measurement(x, 1)
+    if zhat[1] < 1e-3:  # at r̂ = 0 the flip makes ẑ non-differentiable
+        return
+    np.testing.assert_allclose(measurement_jacobian(x, 1), numeric_jacobian(x, 1), atol=1e-5)
+
+
+def test_prediction_equals_the_line_seen_from_the_robot():
+    wall = line_from_points(np.array([[4.0, -2.0], [4.0, 3.0]]))  # x = 4
+    pose = np.array([1.0, 0.5, 0.3])
+    seen = wall.transformed(inverse(pose))
+    zhat = predict_measurement(np.array([*pose, wall.theta, wall.rho]), 0)
+    np.testing.assert_allclose(zhat, [seen.theta, seen.rho], atol=1e-12)
+    # Behind the origin: r̂ < 0 before the flip; the flipped form is the line as seen.
+    pose = np.array([6.0, 0.0, 0.0])
+    zhat = predict_measurement(np.array([*pose, wall.theta, wall.rho]), 0)
+    seen = wall.transformed(inverse(pose))
+    np.testing.assert_allclose(zhat, [seen.theta, seen.rho], atol=1e-12)
+
+
+def test_residual_wraps_angles_and_handles_lines_through_the_robot():
+    np.testing.assert_allclose(residual([0.01, 2.0], [2 * np.pi - 0.01, 2.0]), [0.02, 0.0])
+    # r ≈ 0: (α, r) and (α + π, −r) are one line: not a π residual.
+    np.testing.assert_allclose(residual([np.pi + 0.01, 0.002], [0.0, 0.001]), [0.01, -0.003])
+
+
+def test_line_covariance_follows_arras_siegwart():
+    t = np.linspace(-1, 1, 21)
+    pts = np.column_stack([np.full(21, 2.0), t + 3.0])  # x = 2, centred 3 m from the foot
+    line = line_from_points(pts)
+    cov = line_covariance(pts, line, sigma_floor=0.01)
+    spread = np.sum((t - t.mean()) ** 2)
+    var_a = 0.01**2 / spread
+    assert cov[0, 0] == pytest.approx(var_a)
+    assert cov[1, 1] == pytest.approx(0.01**2 / 21 + 9 * var_a)
+    assert abs(cov[0, 1]) == pytest.approx(3 * var_a)
+    assert np.all(np.linalg.eigvalsh(cov) > 0)
+
+
+def _room_slam():
+    from conftest import ROOM, cast
+
+    slam = EKFLineSLAM(initial_pose=(2.0, 1.5, 0.3))
+    r, a = cast(ROOM, (2.0, 1.5, 0.3))
+    slam.step(r, a, (2.0, 1.5, 0.3), max_range=8.0)
+    return slam, cast, ROOM
+
+
+def test_growing_the_state_keeps_x_and_p():
+    slam, _, _ = _room_slam()
+    assert slam.n_landmarks == 3 and slam.ekf.dim_x == 9
+    assert slam.ekf.P.shape == (9, 9) and slam.ekf._I.shape == (9, 9)
+    x, p = slam.ekf.x.copy(), slam.ekf.P.copy()
+    line = line_from_points(np.array([[1.0, 1.0], [1.0, 2.0]]))
+    slam._add_landmark(line, np.eye(2) * 1e-4)
+    np.testing.assert_array_equal(slam.ekf.x[:9], x)
+    np.testing.assert_array_equal(slam.ekf.P[:9, :9], p)
+    np.testing.assert_allclose(slam.ekf.P, slam.ekf.P.T)
+
+
+def test_singular_innovation_covariance_leaves_the_state_finite():
+    slam, _, _ = _room_slam()
+    slam.ekf.P[:] = 0.0
+    x0 = slam.ekf.x.copy()
+    slam._safe_update(np.array([0.1, 1.0]), np.zeros((2, 2)), [0])  # S = 0: singular
+    np.testing.assert_array_equal(slam.ekf.x, x0)
+    assert np.all(np.isfinite(slam.ekf.P))
+
+
+def test_edge_on_landmark_and_line_through_the_robot_give_no_nan():
+    slam, cast, room = _room_slam()
+    # A wall seen edge-on: three points almost along one beam.
+    edge = line_from_points(np.array([[3.0, 0.0], [3.5, 0.001], [4.0, 0.0]]))
+    pts = np.array([[3.0, 0.0], [3.5, 0.001], [4.0, 0.0]])
+    slam.update([edge], pts)
+    # A line through the robot (r ≈ 0), measured and as a landmark.
+    through = line_from_points(np.array([[-1.0, 0.0], [1.0, 1e-6]]))
+    slam._add_landmark(through, np.eye(2) * 1e-4)
+    slam.update([through], np.array([[-1.0, 0.0], [1.0, 1e-6]]))
+    for k in range(5):
+        r, a = cast(room, (2.0 + 0.05 * k, 1.5, 0.3), seed=k)
+        slam.step(r, a, (2.0 + 0.05 * k, 1.5, 0.3), max_range=8.0)
+    assert np.all(np.isfinite(slam.ekf.x)) and np.all(np.isfinite(slam.ekf.P))
+    assert np.hypot(*(slam.pose[:2] - [2.2, 1.5])) < 0.02
+
+
+@pytest.mark.parametrize("world", ["random:101", "random:106", "random:109", "random:118"])
+def test_ekf_halves_the_odometry_error_on_held_out_worlds(world):
+    from fhslam.metrics import ate
+    from fhslam.sim import OdometryNoise, load_world, simulate
+    from fhslam.slam import run_slam
+
+    log = simulate(load_world(world), seed=0, odometry=OdometryNoise.drifting(), laps=3)
+    r = run_slam(log, "ekf")
+    assert np.all(np.isfinite(r.poses))
+    assert ate(r.poses, log.truth).rmse <= 0.5 * ate(log.odometry, log.truth).rmse

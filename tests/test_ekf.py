@@ -130,3 +130,18 @@ def test_ekf_halves_the_odometry_error_on_held_out_worlds(world):
     r = run_slam(log, "ekf")
     assert np.all(np.isfinite(r.poses))
     assert ate(r.poses, log.truth).rmse <= 0.5 * ate(log.odometry, log.truth).rmse
+
+
+def test_landmarks_through_the_origin_keep_their_extent():
+    """The paper world's walls x = 0 and y = 0 pass through the world origin (r ≈ 0), where a
+    landmark flips between (α, r) and (α + π, −r): its seen extent must not flip with it."""
+    from fhslam.metrics import map_error
+    from fhslam.sim import OdometryNoise, paper_world, simulate
+    from fhslam.slam import run_slam
+
+    log = simulate(paper_world(), seed=2, odometry=OdometryNoise.drifting(), max_scans=250)
+    r = run_slam(log, "ekf")
+    near_origin = [ln for ln in r.map if ln.rho < 0.05]
+    assert near_origin  # the two walls through the origin are landmarks
+    assert all(ln.length <= 14.5 for ln in near_origin)  # no wall there is longer than 14 m
+    assert map_error(r.map, log.world.walls) < 0.05  # was 0.66 m with mirrored extents

@@ -159,7 +159,7 @@ class EKFLineSLAM:
         self.ekf: _MotionEKF | None = None
         self._init_pose = None if initial_pose is None else as_pose(initial_pose)
         self._last_odometry: NDArray | None = None
-        self._extent: list[list[float]] = []  # per landmark: [t_min, t_max] along the line
+        self._ends: list[NDArray] = []  # per landmark: its two extreme observed points (2, 2)
         self._support: list[int] = []
 
     @property
@@ -308,18 +308,22 @@ class EKFLineSLAM:
         rows = gx @ p[:3, :]
         cov_lm = gx @ p[:3, :3] @ gx.T + gz @ cov_z @ gz.T
         self._grow(np.array([a, r]), rows, cov_lm)
-        self._extent.append([np.inf, -np.inf])
+        self._ends.append(np.empty((0, 2)))
         self._support.append(0)
         self._extend(self.n_landmarks - 1, ln)
 
     def _extend(self, j: int, ln: Line) -> None:
-        """Grow landmark j's known extent with the observed segment (for the map output)."""
+        """Grow landmark j's seen extent with the observed segment (for the map output).
+
+        The extremes are kept as world points, not as coordinates along the line: a landmark
+        through the origin (r ≈ 0) flips between (α, r) and (α + π, −r), which would reverse
+        such coordinates.
+        """
         w = ln.transformed(self.ekf.x[:3])
+        pts = np.vstack([self._ends[j], w.sp, w.ep])
         a = self.ekf.x[3 + 2 * j]
-        u = np.array([-np.sin(a), np.cos(a)])
-        t = [float(w.sp @ u), float(w.ep @ u)]
-        e = self._extent[j]
-        e[0], e[1] = min(e[0], *t), max(e[1], *t)
+        t = pts @ np.array([-np.sin(a), np.cos(a)])
+        self._ends[j] = pts[[int(np.argmin(t)), int(np.argmax(t))]]
         self._support[j] += ln.n
 
     def step(self, ranges, angles, odometry, max_range=None) -> tuple[int, int]:
@@ -340,7 +344,7 @@ class EKFLineSLAM:
             a, r = self.ekf.x[3 + 2 * j : 5 + 2 * j]
             n = np.array([np.cos(a), np.sin(a)])
             u = np.array([-n[1], n[0]])
-            lo, hi = self._extent[j]
+            lo, hi = np.sort(self._ends[j] @ u)
             sp, ep = r * n + lo * u, r * n + hi * u
             out.append(
                 Line(rho=float(r), theta=float(a), n=self._support[j], length=float(hi - lo),

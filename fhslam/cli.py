@@ -58,45 +58,96 @@ def _stats_rows(stats: dict[str, object]) -> str:
 
 
 def _evaluate(args: argparse.Namespace) -> None:
-    """Trajectory (and map) errors against the ground truth.
+    """Trajectory (and map) errors against the ground truth, or the relations error.
 
-    Poses are paired by timestamp (``fhslam.metrics.associate``, within ``--max-diff`` s).
-    ATE is not aligned unless ``--align``: the SLAM starts at the true first pose. With
-    ``--world`` and ``--map``, the map is compared with the world's walls: ``map_error`` is
-    the mean distance of the map segments to the walls, and ``map_coverage`` the share of the
-    observed wall points within 5 cm of the map. Nothing is simulated for it: the observed
-    points are the noise-free hits of the paper's laser (181 beams over 180 degrees, 8 m)
-    cast into the world from every 5th pose of the truth file.
+    With ``--truth``: poses are paired by timestamp (``fhslam.metrics.associate``, within
+    ``--max-diff`` s, default 0.01). ATE is not aligned unless ``--align``: the SLAM starts
+    at the true first pose. With ``--world`` and ``--map``, the map is compared with the
+    world's walls: ``map_error`` is the mean distance of the map segments to the walls, and
+    ``map_coverage`` the share of the observed wall points within 5 cm of the map. Nothing is
+    simulated for it: the observed points are the noise-free hits of the paper's laser (181
+    beams over 180 degrees, 8 m) cast into the world from every 5th pose of the truth file.
+
+    With ``--relations``: the Kümmerle et al. (2009) relations error of the trajectory
+    (``fhslam.metrics.relations_error``, relation stamps matched to pose stamps within
+    ``--max-diff`` s, default 0.001), as mean ± std of the absolute and the squared
+    translational (m, m²) and rotational (deg, deg²) errors, Hess et al. (2016) Table II.
     """
     import json
     import math
 
     from fhslam import metrics
-    from fhslam.io import read_map, read_trajectory
+    from fhslam.io import read_map, read_relations, read_trajectory
 
+    if args.relations is not None:
+        given = [
+            opt
+            for opt, value in (
+                ("--world", args.world),
+                ("--map", args.map),
+                ("--delta", args.delta),
+                ("--align", args.align or None),
+            )
+            if value is not None
+        ]
+        if given:
+            raise ValueError(f"{', '.join(given)}: only with --truth, not with --relations")
+        max_diff = 0.001 if args.max_diff is None else args.max_diff
+        t_est, est = read_trajectory(args.trajectory)
+        t1, t2, rel = read_relations(args.relations)
+        try:
+            rerr = metrics.relations_error(t_est, est, t1, t2, rel, max_diff=max_diff)
+        except ValueError as e:
+            raise ValueError(f"{args.trajectory} and {args.relations}: {e}") from None
+        if args.json:
+            out: dict[str, float | int] = {
+                f"relations_{k}": v
+                for k, v in rerr.as_dict().items()
+                if k not in ("n_used", "n_total")
+            }
+            out.update(relations_used=rerr.n_used, relations_total=rerr.n_total)
+            print(json.dumps(out, allow_nan=False))
+            return
+        print(
+            f"{args.trajectory} vs {args.relations} "
+            f"(relation and pose timestamps matched within {max_diff:g} s)"
+        )
+        print(
+            f"translational error: {rerr.trans_mean:.4f} ± {rerr.trans_std:.4f} m, "
+            f"squared {rerr.trans_sq_mean:.4f} ± {rerr.trans_sq_std:.4f} m²"
+        )
+        print(
+            f"rotational error:    {rerr.rot_mean_deg:.3f} ± {rerr.rot_std_deg:.3f} deg, "
+            f"squared {rerr.rot_sq_mean_deg:.3f} ± {rerr.rot_sq_std_deg:.3f} deg²"
+        )
+        print(f"{rerr.n_used} of {rerr.n_total} relations used")
+        return
+
+    max_diff = 0.01 if args.max_diff is None else args.max_diff
+    delta = 1 if args.delta is None else args.delta
     if (args.world is None) != (args.map is None):
         given, missing = ("--world", "--map") if args.map is None else ("--map", "--world")
         raise ValueError(f"{given} needs {missing}: the map is compared with the world's walls")
     t_est, est = read_trajectory(args.trajectory)
     t_ref, ref = read_trajectory(args.truth)
-    i_est, i_ref = metrics.associate(t_est, t_ref, max_diff=args.max_diff)
+    i_est, i_ref = metrics.associate(t_est, t_ref, max_diff=max_diff)
     if len(i_est) < 2:
         raise ValueError(
             f"{args.trajectory} and {args.truth}: only {len(i_est)} poses have matching "
-            f"timestamps (within {args.max_diff:g} s); at least 2 are needed"
+            f"timestamps (within {max_diff:g} s); at least 2 are needed"
         )
     e, r = est[i_est], ref[i_ref]
     stats = {
         "ate": metrics.ate(e, r, align=args.align),
-        "rpe_trans": metrics.rpe(e, r, delta=args.delta),
-        "rpe_rot": metrics.rpe_rot_deg(e, r, delta=args.delta),
+        "rpe_trans": metrics.rpe(e, r, delta=delta),
+        "rpe_rot": metrics.rpe_rot_deg(e, r, delta=delta),
     }
     result: dict[str, float | int | None] = {}
     for name, st in stats.items():
         unit = "_deg" if name == "rpe_rot" else ""
         result.update({f"{name}_{k}{unit}": v for k, v in st.as_dict().items()})
     result.update(n_poses=len(i_est), n_est=len(t_est), n_truth=len(t_ref))
-    result["n_rpe_pairs"] = len(metrics.rpe_pairs(len(e), args.delta))
+    result["n_rpe_pairs"] = len(metrics.rpe_pairs(len(e), delta))
 
     if args.world is not None:
         from fhslam.sim import load_world
@@ -123,7 +174,7 @@ def _evaluate(args: argparse.Namespace) -> None:
     if args.align:
         labels["ate"] = "ATE aligned (m)"
     print(_stats_rows({labels[k]: v for k, v in stats.items()}))
-    print(f"RPE over {result['n_rpe_pairs']} pairs {args.delta} frame(s) apart")
+    print(f"RPE over {result['n_rpe_pairs']} pairs {delta} frame(s) apart")
     if args.world is not None:
         err, cov = result["map_error"], result["map_coverage"]
         print(
@@ -145,11 +196,26 @@ def _reproduce(args: argparse.Namespace) -> None:
         print(path)
 
 
+def load_log(source: str, scan_topic=None, odom_topic=None, download=False):
+    """A log from a CARMEN file, a ROS bag, or a dataset name (``intel``, ``aces``, ...)."""
+    from fhslam.data import DATASETS, find_dataset
+    from fhslam.io import is_bag, read_bag, read_carmen
+
+    path = Path(source)
+    if not path.exists() and source in DATASETS:
+        path = find_dataset(source, "log", download=download)
+    if is_bag(path):
+        return read_bag(path, scan_topic=scan_topic, odom_topic=odom_topic)
+    if scan_topic or odom_topic:
+        raise ValueError(f"{path}: --scan-topic/--odom-topic apply to ROS bags only")
+    return read_carmen(path)
+
+
 def _slam(args: argparse.Namespace) -> None:
-    from fhslam.io import read_carmen, write_map, write_trajectory
+    from fhslam.io import write_map, write_trajectory
     from fhslam.slam import run_slam
 
-    log = read_carmen(args.log)
+    log = load_log(args.log, args.scan_topic, args.odom_topic, args.download)
     result = run_slam(log, args.method, progress=not args.quiet and len(log) > 200)
     # Everything is computed before anything is written: bad input leaves no half files.
     write_trajectory(
@@ -195,7 +261,16 @@ def build_parser() -> argparse.ArgumentParser:
     p.set_defaults(run=_simulate)
 
     p = sub.add_parser("slam", help="run SLAM on a log: trajectory and line map")
-    p.add_argument("log", type=Path, help="CARMEN text log (.clf)")
+    p.add_argument(
+        "log", help="CARMEN log (.clf), ROS 1/2 bag, or a dataset name (intel, aces, ...)"
+    )
+    p.add_argument("--scan-topic", help="LaserScan topic of a bag (default: found by type)")
+    p.add_argument("--odom-topic", help="Odometry topic of a bag (default: found by type)")
+    p.add_argument(
+        "--download",
+        action="store_true",
+        help="fetch a named dataset into the user cache if no local copy is found",
+    )
     p.add_argument(
         "--method",
         choices=("fht", "classical", "ekf", "odometry"),
@@ -214,29 +289,46 @@ def build_parser() -> argparse.ArgumentParser:
 
     p = sub.add_parser(
         "evaluate",
-        help="trajectory errors (ATE, RPE) against ground truth; map errors against a world",
+        help="trajectory errors against ground truth (ATE, RPE, map) or benchmark relations",
         description=(
-            "Compare an estimated trajectory with the ground truth, pose by pose matched by "
-            "timestamp: ATE (no alignment unless --align) and RPE, in metres and degrees. "
-            "With --world and --map also the map error (mean distance of the map's segments "
-            "to the walls) and coverage (share of the wall points the laser saw that lie "
-            "within 5 cm of the map). The seen wall points are not simulated: they are the "
-            "noise-free hits of a 181-beam, 180 degree, 8 m laser cast into the world from "
-            "every 5th true pose."
+            "With --truth: compare an estimated trajectory with the ground truth, pose by "
+            "pose matched by timestamp: ATE (no alignment unless --align) and RPE, in metres "
+            "and degrees. With --world and --map also the map error (mean distance of the "
+            "map's segments to the walls) and coverage (share of the wall points the laser "
+            "saw that lie within 5 cm of the map). The seen wall points are not simulated: "
+            "they are the noise-free hits of a 181-beam, 180 degree, 8 m laser cast into the "
+            "world from every 5th true pose. "
+            "With --relations: the relations error of Kuemmerle et al. (2009) against a "
+            "Freiburg SLAM-benchmark .relations file, reported as in Hess et al. (2016), "
+            "Table II: mean and std of the absolute and the squared translational (m, m^2) "
+            "and rotational (deg, deg^2) errors."
         ),
     )
     p.add_argument("trajectory", type=Path, help="estimated trajectory (timestamp x y theta)")
-    p.add_argument("--truth", required=True, type=Path, help="ground-truth trajectory file")
-    p.add_argument("--world", help="built-in world ('paper', 'random:SEED') or world JSON file")
-    p.add_argument("--map", type=Path, help="map JSON of the run (needs --world)")
+    reference = p.add_mutually_exclusive_group(required=True)
+    reference.add_argument("--truth", type=Path, help="ground-truth trajectory file")
+    reference.add_argument(
+        "--relations",
+        type=Path,
+        help="benchmark relations file (timestamp1 timestamp2 x y z roll pitch yaw)",
+    )
+    p.add_argument(
+        "--world", help="built-in world ('paper', 'random:SEED') or world JSON file (--truth)"
+    )
+    p.add_argument("--map", type=Path, help="map JSON of the run (needs --world and --truth)")
     p.add_argument(
         "--max-diff",
         type=float,
-        default=0.01,
-        help="largest timestamp difference of matched poses, s (default 0.01)",
+        default=None,
+        help="largest timestamp difference of matched poses, s (default 0.01 with --truth, "
+        "0.001 with --relations)",
     )
-    p.add_argument("--delta", type=int, default=1, help="RPE frame distance (default 1)")
-    p.add_argument("--align", action="store_true", help="SE(2)-align the estimate before ATE")
+    p.add_argument(
+        "--delta", type=int, default=None, help="RPE frame distance (default 1; --truth only)"
+    )
+    p.add_argument(
+        "--align", action="store_true", help="SE(2)-align the estimate before ATE (--truth only)"
+    )
     p.add_argument("--json", action="store_true", help="print one JSON object")
     p.set_defaults(run=_evaluate)
 

@@ -26,7 +26,7 @@ from numpy.typing import ArrayLike, NDArray
 from tqdm.auto import tqdm
 
 from fhslam.extraction import ExtractionParams, extract_lines, scan_to_points
-from fhslam.geometry import as_pose, compose, relative, signed_distance, wrap_angle
+from fhslam.geometry import as_pose, compose, inverse, relative, signed_distance, wrap_angle
 from fhslam.lines import Line, transform_lines
 from fhslam.matching import MatchParams, match_lines, merge
 
@@ -340,6 +340,12 @@ def run_slam(
     Every method starts at the first odometry pose, which a simulated log sets to the true
     start ("suppose the initial localization of mobile robot is correct").
     """
+    offset = getattr(log, "laser_offset", None)
+    if offset is not None and np.any(offset != 0) and method != "odometry":
+        # The laser sits off the robot's origin: estimate laser poses, report robot poses.
+        laser_log = replace(log, odometry=compose(log.odometry, offset), laser_offset=None)
+        r = run_slam(laser_log, method, params, progress)
+        return replace(r, poses=compose(r.poses, inverse(offset)))
     if method == "odometry":
         return SlamResult(
             np.asarray(log.timestamps, float), np.asarray(log.odometry, float), [], []

@@ -308,3 +308,28 @@ def test_slam_methods_through_the_command_line(tmp_path, method):
     assert odo.returncode == 0
     o = json.loads(run("evaluate", str(tmp_path / "o"), "--truth", str(truth), "--json").stdout)
     assert json.loads(r.stdout)["ate_rmse"] <= 0.5 * o["ate_rmse"]
+
+
+def test_slam_reads_a_bag_and_a_bag_without_odometry_exits_2(tmp_path):
+    from test_rosbag import write_bag
+
+    good = write_bag(tmp_path / "g.bag", scans=5)
+    r = run("slam", str(good), "--trajectory", str(tmp_path / "t.txt"), "--quiet")
+    assert r.returncode == 0, r.stderr
+    t, _ = read_trajectory(tmp_path / "t.txt")
+    np.testing.assert_allclose(t, [10, 11, 12, 13, 14])
+    bad = write_bag(tmp_path / "n.bag", odom=False)
+    r = run("slam", str(bad), "--trajectory", str(tmp_path / "u.txt"))
+    assert r.returncode == 2 and "n.bag: the bag has no odometry" in r.stderr
+    assert r.stderr.count("\n") == 1 and not (tmp_path / "u.txt").exists()
+
+
+def test_slam_on_a_dataset_name_then_relations(tmp_path, real_data, monkeypatch):
+    monkeypatch.setenv("FHSLAM_DATA", str(real_data))
+    traj = tmp_path / "odo.txt"
+    r = run("slam", "mit-csail", "--method", "odometry", "--trajectory", str(traj))
+    assert r.returncode == 0, r.stderr
+    r = run("evaluate", str(traj), "--relations", str(real_data / "mit-csail.relations"), "--json")
+    out = json.loads(r.stdout)
+    assert out["relations_used"] == out["relations_total"] == 1172
+    assert 1.0 < out["relations_trans_mean"] < 3.0  # raw odometry: 1.68 m

@@ -122,3 +122,22 @@ def test_dropped_scans_and_clutter_at_most_double_the_ate(world, laps):
     clean, bad = _run(world, laps), _run(world, laps, degraded=True)
     assert bad["ate"] <= 2.0 * clean["ate"]
     assert bad["ate"] <= 0.15
+
+
+def test_laser_mounted_off_the_robot_origin_reports_robot_poses():
+    """A log whose scans come from a laser 0.25 m ahead of the robot's origin."""
+    from dataclasses import replace
+
+    from fhslam.metrics import ate
+    from fhslam.sim import OdometryNoise, paper_world, simulate
+
+    offset = np.array([0.25, 0.0, 0.0])  # robot_T_laser
+    sim = simulate(paper_world(), seed=1, odometry=OdometryNoise.drifting(), max_scans=400)
+    # The simulated poses are the laser's; the robot sits 0.25 m behind it.
+    robot_truth = compose(sim.truth, inverse(offset))
+    log = replace(sim, odometry=compose(sim.odometry, inverse(offset)), truth=robot_truth,
+                  laser_offset=offset)  # fmt: skip
+    with_offset = ate(run_slam(log).poses, robot_truth).rmse
+    ignoring = ate(run_slam(replace(log, laser_offset=None)).poses, robot_truth).rmse
+    assert with_offset < 0.05
+    assert with_offset < 0.5 * ignoring  # pretending the laser is at the origin is worse

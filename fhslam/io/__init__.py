@@ -1,19 +1,27 @@
-"""Reading and writing logs, trajectories and maps: CARMEN logs, trajectory files, map JSON."""
+"""Reading and writing logs, trajectories and maps: CARMEN logs, trajectory files, map JSON,
+benchmark relations files."""
 
 from fhslam.io.carmen import CarmenFormatError, flaser_angles, read_carmen, write_carmen
 from fhslam.io.log import Log
 from fhslam.io.mapfile import MapFormatError, lines_from_segments, read_map, write_map
+from fhslam.io.relations import RelationsFormatError, read_relations
+from fhslam.io.rosbag import BagFormatError, is_bag, read_bag
 from fhslam.io.trajectory import TrajectoryFormatError, read_trajectory, write_trajectory
 
 __all__ = [
+    "BagFormatError",
     "CarmenFormatError",
     "Log",
     "MapFormatError",
+    "RelationsFormatError",
     "TrajectoryFormatError",
     "flaser_angles",
+    "is_bag",
     "lines_from_segments",
+    "read_bag",
     "read_carmen",
     "read_map",
+    "read_relations",
     "read_trajectory",
     "write_carmen",
     "write_map",

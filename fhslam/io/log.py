@@ -43,6 +43,10 @@ class Log:
         Index of the wall of ``world`` hit by each beam, -1 for no return (simulated only).
     world : World or None
         The world the log was simulated in.
+    laser_offset : ndarray, shape (3,)
+        Pose of the laser on the robot, ``robot_T_laser`` (zero: the laser at the robot's
+        origin). SLAM estimates laser poses ``odometry ⊕ laser_offset`` and reports robot
+        poses.
     """
 
     name: str
@@ -54,8 +58,14 @@ class Log:
     truth: NDArray[np.float64] | None = None
     hits: NDArray[np.intp] | None = None
     world: World | None = None
+    laser_offset: NDArray[np.float64] | None = None
 
     def __post_init__(self) -> None:
+        self.laser_offset = (
+            np.zeros(3) if self.laser_offset is None else np.asarray(self.laser_offset, float)
+        )
+        if self.laser_offset.shape != (3,) or not np.all(np.isfinite(self.laser_offset)):
+            raise ValueError(f"Log.laser_offset must be 3 finite numbers, got {self.laser_offset}")
         self.timestamps = np.asarray(self.timestamps, dtype=float)
         self.ranges = np.asarray(self.ranges, dtype=float)
         self.angles = np.asarray(self.angles, dtype=float)

@@ -1,0 +1,340 @@
+"""The real laser logs of the Freiburg SLAM benchmark: find them by name, or fetch them.
+
+The files are not part of the package (nobody on the team wrote them; see
+``shared/data/SOURCES.md``). :func:`find_dataset` looks for a dataset's file, in this order:
+
+1. an explicit path to an existing file;
+2. the folder named by the environment variable ``$FHSLAM_DATA``;
+3. a ``shared/data`` folder beside the repository: ``<ancestor>/../shared/data`` for the
+   current working directory and each of its ancestors, then beside this source tree (an
+   editable install);
+4. only with ``download=True``: a download, checked against the recorded sha256, into the
+   user cache (``pooch.os_cache("fhslam")``).
+
+A local copy is only checked by size (cheap); :func:`verify` computes its sha256.
+
+**aces**, **fr079** and **fr-clinic** are held out for evaluation: never tune a parameter on
+them (:func:`is_held_out`). Develop and tune on **intel** and **mit-csail**.
+
+The data comes from the Freiburg "SLAM benchmarking" page; cite R. Kümmerle et al., "On
+measuring the accuracy of SLAM algorithms", Autonomous Robots 27(4):387-407, 2009.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import os
+from collections.abc import Iterator
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Literal
+
+__all__ = [
+    "DATASETS",
+    "ENV_VAR",
+    "SOURCE_COMMIT",
+    "SOURCE_REPO",
+    "DataFile",
+    "Dataset",
+    "DatasetNotFoundError",
+    "find_dataset",
+    "is_held_out",
+    "search_dirs",
+    "verify",
+]
+
+ENV_VAR = "FHSLAM_DATA"
+SOURCE_REPO = "INESCTEC/ricoslam"
+SOURCE_COMMIT = "52bfaa91c8e5e56f119265d409b1692ca29d48d2"
+_RAW_BASE = (
+    f"https://raw.githubusercontent.com/{SOURCE_REPO}/{SOURCE_COMMIT}"
+    "/inesctec_mrdt_slam_2d_datasets"
+)
+
+Kind = Literal["log", "relations"]
+KINDS: tuple[str, ...] = ("log", "relations")
+
+
+class DatasetNotFoundError(FileNotFoundError):
+    """No copy of a dataset file was found (and no download was asked for)."""
+
+
+@dataclass(frozen=True)
+class DataFile:
+    """One file of a dataset: its name, where it lives upstream, its size and sha256."""
+
+    name: str
+    url: str
+    size: int
+    sha256: str
+
+    @property
+    def known_hash(self) -> str:
+        """The hash in ``pooch``'s form, ``sha256:<hex>``."""
+        return f"sha256:{self.sha256}"
+
+
+@dataclass(frozen=True)
+class Dataset:
+    """A benchmark dataset: its laser log (``None`` if there is none) and its relations."""
+
+    name: str
+    log: DataFile | None
+    relations: DataFile
+    held_out: bool
+
+    def file(self, kind: str) -> DataFile:
+        """The :class:`DataFile` of ``kind`` (``"log"`` or ``"relations"``)."""
+        if kind not in KINDS:
+            raise ValueError(f"kind must be one of {KINDS}, not {kind!r}")
+        f = self.log if kind == "log" else self.relations
+        if f is None:
+            raise ValueError(
+                f"dataset {self.name!r} has no {kind} file (only its relations are available)"
+            )
+        return f
+
+    def files(self) -> Iterator[tuple[str, DataFile]]:
+        """``(kind, file)`` for each file the dataset has."""
+        for kind in KINDS:
+            f = self.log if kind == "log" else self.relations
+            if f is not None:
+                yield kind, f
+
+
+def _bag(name: str, size: int, sha256: str) -> DataFile:
+    return DataFile(name, f"{_RAW_BASE}/bag/{name}", size, sha256)
+
+
+def _text(name: str, size: int, sha256: str) -> DataFile:
+    return DataFile(name, f"{_RAW_BASE}/data/{name}", size, sha256)
+
+
+DATASETS: dict[str, Dataset] = {
+    d.name: d
+    for d in (
+        Dataset(
+            "intel",
+            _bag(
+                "intel.orig.bag",
+                3954281,
+                "b37cdd3988b49893edb7afe353d55739327a6e68196f257e62e7fb287860fb5d",
+            ),
+            _text(
+                "intel.relations",
+                265713,
+                "330378f153eeae652d6756c1746f335801f66c3e097d90611548e6c4f593c359",
+            ),
+            held_out=False,
+        ),
+        Dataset(
+            "aces",
+            _bag(
+                "aces.orig.bag",
+                1377795,
+                "f94635f90d6f91e06a557bfe7d544cdd560067128b2b7825dcbc645f941247bd",
+            ),
+            _text(
+                "aces.relations",
+                99426,
+                "11a15800a751b6f9413078a021d49c7cda85a768c2a465433b4fae7ef57b03d5",
+            ),
+            held_out=True,
+        ),
+        Dataset(
+            "fr079",
+            _bag(
+                "fr079.orig.bag",
+                2235503,
+                "50d56192e2d30ca502810b81d00f08a1a6097cf5c8ee172d5dac29a0b2e7abd2",
+            ),
+            _text(
+                "fr079.relations",
+                133044,
+                "7e7f06b4aca455cb68f1f23d04e7c7316c5e17773e872734c860ed7a274cdfc7",
+            ),
+            held_out=True,
+        ),
+        Dataset(
+            "fr-clinic",
+            _bag(
+                "fr-clinic_robotlaser.orig.bag",
+                2396166,
+                "0b5c3f5b24d277e2a0e38b385f6c09c6cf12e490f6ae7990978f0743bf1aebaf",
+            ),
+            _text(
+                "fr-clinic.relations",
+                260314,
+                "583b7bba8c1a3ef1f7ad41221c151534333e71b52f5fc267d5e343c79355300c",
+            ),
+            held_out=True,
+        ),
+        Dataset(
+            "mit-csail",
+            _text(
+                "mit-csail.clf",
+                3843167,
+                "f40f31cf9e561cb2a0cb0ca2f4a809abb319543cd1b2875f6c8c6a0138559ca4",
+            ),
+            _text(
+                "mit-csail.relations",
+                98468,
+                "ffd7ebe97fa1738913931e39ca643ee0a1b67de80499b0197a3d01abad0f589d",
+            ),
+            held_out=False,
+        ),
+        Dataset(
+            "mit-killian",
+            None,
+            _text(
+                "mit-killian.relations",
+                426269,
+                "0b0f8dfc0746f9dee20b9d6d2a47a805674fd2f5be94f0ba11876bc6e97fab4b",
+            ),
+            held_out=False,
+        ),
+    )
+}
+"""The known datasets by name. Files and hashes are those of ``shared/data/SOURCES.md``."""
+
+
+def _known() -> str:
+    return ", ".join(sorted(DATASETS))
+
+
+def _dataset(name: str) -> Dataset:
+    try:
+        return DATASETS[name]
+    except KeyError:
+        raise ValueError(f"unknown dataset {name!r}; known datasets: {_known()}") from None
+
+
+def is_held_out(name: str) -> bool:
+    """Whether ``name`` is held out for evaluation (never tune a parameter on it)."""
+    return _dataset(name).held_out
+
+
+def search_dirs() -> list[tuple[str, Path]]:
+    """The local folders looked in, in order, as ``(why, folder)``; missing ones included."""
+    dirs: list[tuple[str, Path]] = []
+    env = os.environ.get(ENV_VAR)
+    if env:
+        dirs.append((f"${ENV_VAR}", Path(env).expanduser()))
+    cwd = Path.cwd().resolve()
+    for anc in (cwd, *cwd.parents):
+        dirs.append(("../shared/data beside the working directory", anc.parent / "shared" / "data"))
+    source_root = Path(__file__).resolve().parents[2]
+    dirs.append(("../shared/data beside the source tree", source_root / "shared" / "data"))
+    seen: set[Path] = set()
+    unique = []
+    for why, d in dirs:
+        if d not in seen:
+            seen.add(d)
+            unique.append((why, d))
+    return unique
+
+
+def _by_file_name(name: str) -> tuple[Dataset, str] | None:
+    for ds in DATASETS.values():
+        for kind, f in ds.files():
+            if f.name == name:
+                return ds, kind
+    return None
+
+
+def _looks_like_path(s: str | os.PathLike[str]) -> bool:
+    if isinstance(s, os.PathLike):
+        return True
+    return os.sep in s or (os.altsep is not None and os.altsep in s) or s.startswith("~")
+
+
+def find_dataset(
+    name_or_path: str | os.PathLike[str], kind: str = "log", download: bool = False
+) -> Path:
+    """The path of a dataset's ``kind`` file (``"log"`` or ``"relations"``).
+
+    ``name_or_path`` is an existing file (returned as is), a dataset name (``"intel"``;
+    see :data:`DATASETS`) or one of the datasets' file names (``"intel.relations"``, whose
+    kind then overrides ``kind``). The places looked in are in the module docstring; nothing
+    is downloaded unless ``download=True``.
+
+    Raises :class:`DatasetNotFoundError` (a ``FileNotFoundError``) listing every place looked
+    at, ``ValueError`` for an unknown name or kind, for a dataset without that file, and for a
+    local copy whose size is not the recorded one.
+    """
+    if kind not in KINDS:
+        raise ValueError(f"kind must be one of {KINDS}, not {kind!r}")
+    p = Path(name_or_path).expanduser()
+    if p.is_file():
+        return p
+    text = os.fspath(name_or_path)
+    if text in DATASETS:
+        ds = DATASETS[text]
+    elif (hit := _by_file_name(text)) is not None:
+        ds, kind = hit
+    elif _looks_like_path(name_or_path):
+        raise DatasetNotFoundError(f"{text}: no such file (and not a dataset name: {_known()})")
+    else:
+        raise ValueError(f"unknown dataset {text!r}; known datasets: {_known()}")
+    f = ds.file(kind)
+
+    looked: list[str] = []
+    if os.environ.get(ENV_VAR) is None:
+        looked.append(f"${ENV_VAR} (not set)")
+    for why, d in search_dirs():
+        cand = d / f.name
+        looked.append(f"{cand} ({why})")
+        if cand.is_file():
+            _check_size(cand, f)
+            return cand
+
+    if download:
+        import pooch
+
+        got = pooch.retrieve(
+            f.url, known_hash=f.known_hash, fname=f.name, path=pooch.os_cache("fhslam")
+        )
+        return Path(got)
+
+    places = "\n".join(f"  - {s}" for s in looked)
+    raise DatasetNotFoundError(
+        f"{f.name} ({ds.name} {kind}) not found. Looked in:\n{places}\n"
+        f"Fix: set {ENV_VAR} to a folder holding {f.name}, or pass download=True "
+        f"(`--download` on the command line) to fetch it from {f.url} "
+        "(checked against its sha256) into the user cache."
+    )
+
+
+def _check_size(path: Path, f: DataFile) -> None:
+    size = path.stat().st_size
+    if size != f.size:
+        hint = " (a Git LFS pointer, not the data?)" if size < 1024 else ""
+        raise ValueError(
+            f"{path}: {size} bytes, but {f.name} has {f.size} bytes{hint}; "
+            f"replace it with the file from {f.url}"
+        )
+
+
+def _sha256(path: Path) -> str:
+    h = hashlib.sha256()
+    with open(path, "rb") as fh:
+        for block in iter(lambda: fh.read(1 << 20), b""):
+            h.update(block)
+    return h.hexdigest()
+
+
+def verify(name: str, download: bool = False) -> dict[str, Path]:
+    """Find every file of dataset ``name`` and check its sha256; ``{kind: path}``.
+
+    Raises ``ValueError`` naming the file whose hash is not the recorded one, and
+    :class:`DatasetNotFoundError` as :func:`find_dataset` does.
+    """
+    ds = _dataset(name)
+    found: dict[str, Path] = {}
+    for kind, f in ds.files():
+        path = find_dataset(name, kind=kind, download=download)
+        digest = _sha256(path)
+        if digest != f.sha256:
+            raise ValueError(f"{path}: sha256 {digest}, but {f.name} has sha256 {f.sha256}")
+        found[kind] = path
+    return found

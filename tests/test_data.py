@@ -1,0 +1,258 @@
+"""Finding the real datasets by name: lookup order, errors, and downloads (never real ones)."""
+
+from __future__ import annotations
+
+import hashlib
+import re
+from pathlib import Path
+
+import pooch
+import pytest
+
+from fhslam import data
+from fhslam.data import DATASETS, Dataset, DatasetNotFoundError, find_dataset, is_held_out, verify
+
+SHARED = Path(__file__).resolve().parents[2] / "shared" / "data"
+
+FAKE_LOG = b"FLASER 3 1.0 2.0 3.0 0 0 0 0 0 0 1.0 host 1.0\n"
+FAKE_REL = b"1.0 2.0 0.1 0 0 0 0 0\n"
+
+
+@pytest.fixture(autouse=True)
+def _no_network(monkeypatch):
+    """No test may reach pooch's downloader; those that expect a call replace this."""
+
+    def refuse(*args, **kwargs):
+        raise AssertionError(f"pooch.retrieve called: {args} {kwargs}")
+
+    monkeypatch.setattr(pooch, "retrieve", refuse)
+
+
+@pytest.fixture
+def fake(monkeypatch, tmp_path):
+    """A registry entry 'fake' whose files are tiny, and an isolated working directory.
+
+    Layout: tmp/work/repo is the working directory, tmp/work/shared/data is its
+    ../shared/data, tmp/env is for $FHSLAM_DATA.
+    """
+    log = data.DataFile(
+        "fake.clf",
+        "https://example.invalid/fake.clf",
+        len(FAKE_LOG),
+        hashlib.sha256(FAKE_LOG).hexdigest(),
+    )
+    rel = data.DataFile(
+        "fake.relations",
+        "https://example.invalid/fake.relations",
+        len(FAKE_REL),
+        hashlib.sha256(FAKE_REL).hexdigest(),
+    )
+    monkeypatch.setitem(DATASETS, "fake", Dataset("fake", log, rel, held_out=False))
+    repo = tmp_path / "work" / "repo"
+    repo.mkdir(parents=True)
+    monkeypatch.chdir(repo)
+    monkeypatch.delenv(data.ENV_VAR, raising=False)
+    return tmp_path
+
+
+def _put(folder: Path, name: str, content: bytes) -> Path:
+    folder.mkdir(parents=True, exist_ok=True)
+    (folder / name).write_bytes(content)
+    return folder / name
+
+
+def test_registry_matches_design():
+    assert set(DATASETS) == {"intel", "aces", "fr079", "fr-clinic", "mit-csail", "mit-killian"}
+    assert {n for n in DATASETS if is_held_out(n)} == {"aces", "fr079", "fr-clinic"}
+    assert DATASETS["intel"].log.name == "intel.orig.bag"
+    assert DATASETS["mit-csail"].log.name == "mit-csail.clf"
+    assert DATASETS["fr-clinic"].log.name == "fr-clinic_robotlaser.orig.bag"
+    assert DATASETS["mit-killian"].log is None
+    base = f"https://raw.githubusercontent.com/INESCTEC/ricoslam/{data.SOURCE_COMMIT}/"
+    base += "inesctec_mrdt_slam_2d_datasets/"
+    for ds in DATASETS.values():
+        for _, f in ds.files():
+            folder = "bag" if f.name.endswith(".bag") else "data"
+            assert f.url == base + folder + "/" + f.name
+            assert re.fullmatch(r"[0-9a-f]{64}", f.sha256)
+
+
+def test_registry_matches_sources_md():
+    sources = SHARED / "SOURCES.md"
+    if not sources.is_file():
+        pytest.skip(f"no {sources} to compare the registry with")
+    rows = {}
+    for line in sources.read_text().splitlines():
+        cells = [c.strip() for c in line.strip().strip("|").split("|")]
+        if len(cells) >= 4 and cells[1].startswith("inesctec_mrdt_slam_2d_datasets/"):
+            rows[cells[0].removeprefix("data/")] = (cells[1], int(cells[2]), cells[3])
+    files = [f for ds in DATASETS.values() for _, f in ds.files()]
+    assert {f.name for f in files} == set(rows)
+    for f in files:
+        path, size, sha = rows[f.name]
+        assert f.url.endswith("/" + path)
+        assert (f.size, f.sha256) == (size, sha)
+
+
+def test_unknown_name_lists_known_names():
+    with pytest.raises(ValueError, match="unknown dataset 'nope'") as e:
+        find_dataset("nope")
+    for name in DATASETS:
+        assert name in str(e.value)
+    with pytest.raises(ValueError, match="intel"):
+        is_held_out("nope")
+
+
+def test_bad_kind_and_missing_log():
+    with pytest.raises(ValueError, match="kind"):
+        find_dataset("intel", kind="map")
+    with pytest.raises(ValueError, match=r"mit-killian.*no log"):
+        find_dataset("mit-killian", kind="log")
+
+
+def test_explicit_path_wins(fake, monkeypatch):
+    explicit = _put(fake / "elsewhere", "my.clf", b"anything at all")
+    monkeypatch.setenv(data.ENV_VAR, str(_put(fake / "env", "fake.clf", FAKE_LOG).parent))
+    assert find_dataset(explicit) == explicit
+    assert find_dataset(str(explicit), kind="relations") == explicit
+
+
+def test_missing_explicit_path_is_not_found(fake):
+    with pytest.raises(DatasetNotFoundError, match="no such file"):
+        find_dataset(fake / "missing.clf")
+
+
+def test_env_wins_over_shared_data(fake, monkeypatch):
+    shared = _put(fake / "work" / "shared" / "data", "fake.clf", FAKE_LOG)
+    assert find_dataset("fake") == shared
+    env = _put(fake / "env", "fake.clf", FAKE_LOG)
+    monkeypatch.setenv(data.ENV_VAR, str(env.parent))
+    assert find_dataset("fake") == env
+
+
+def test_env_without_the_file_falls_through(fake, monkeypatch):
+    (fake / "env").mkdir()
+    monkeypatch.setenv(data.ENV_VAR, str(fake / "env"))
+    shared = _put(fake / "work" / "shared" / "data", "fake.relations", FAKE_REL)
+    assert find_dataset("fake", kind="relations") == shared
+
+
+def test_shared_data_beside_an_ancestor_of_the_cwd(fake, monkeypatch):
+    shared = _put(fake / "work" / "shared" / "data", "fake.clf", FAKE_LOG)
+    deep = fake / "work" / "repo" / "notebooks" / "sub"
+    deep.mkdir(parents=True)
+    monkeypatch.chdir(deep)
+    assert find_dataset("fake") == shared
+
+
+def test_file_name_selects_dataset_and_kind(fake):
+    shared = _put(fake / "work" / "shared" / "data", "fake.relations", FAKE_REL)
+    assert find_dataset("fake.relations") == shared
+
+
+def test_size_mismatch_is_a_value_error(fake, monkeypatch, recwarn):
+    env = _put(fake / "env", "fake.clf", b"version https://git-lfs.github.com/spec/v1\n")
+    monkeypatch.setenv(data.ENV_VAR, str(env.parent))
+    with pytest.raises(ValueError, match=re.escape(str(env))):
+        find_dataset("fake")
+    assert len(recwarn) == 0
+
+
+def test_not_found_lists_places_and_fixes(fake, monkeypatch):
+    monkeypatch.setattr(data, "__file__", str(fake / "site" / "pkg" / "fhslam" / "data.py"))
+    with pytest.raises(DatasetNotFoundError) as e:
+        find_dataset("fake", kind="relations")
+    msg = str(e.value)
+    assert isinstance(e.value, FileNotFoundError)
+    assert "fake.relations" in msg
+    assert "$FHSLAM_DATA (not set)" in msg
+    for _, d in data.search_dirs():
+        assert str(d / "fake.relations") in msg
+    assert str(fake / "work" / "shared" / "data" / "fake.relations") in msg
+    assert str(fake / "site" / "shared" / "data" / "fake.relations") in msg
+    assert "download=True" in msg and "--download" in msg
+
+    monkeypatch.setenv(data.ENV_VAR, str(fake / "env"))
+    with pytest.raises(DatasetNotFoundError, match=re.escape(str(fake / "env" / "fake.relations"))):
+        find_dataset("fake", kind="relations")
+
+
+def test_no_download_never_calls_pooch(fake):
+    # the autouse fixture makes any pooch.retrieve call fail the test
+    with pytest.raises(DatasetNotFoundError):
+        find_dataset("fake")
+    with pytest.raises(DatasetNotFoundError):
+        verify("fake")
+
+
+def test_download_calls_pooch_with_url_and_hash(fake, monkeypatch):
+    calls = []
+    cached = _put(fake / "cache", "fake.clf", FAKE_LOG)
+
+    def retrieve(url, known_hash=None, fname=None, path=None, **kwargs):
+        calls.append((url, known_hash, fname, path))
+        return str(cached)
+
+    monkeypatch.setattr(pooch, "retrieve", retrieve)
+    assert find_dataset("fake", download=True) == cached
+    f = DATASETS["fake"].log
+    assert calls == [(f.url, "sha256:" + f.sha256, "fake.clf", pooch.os_cache("fhslam"))]
+
+
+def test_download_of_a_real_entry_uses_its_github_url(fake, monkeypatch):
+    seen = {}
+
+    def retrieve(url, known_hash=None, **kwargs):
+        seen.update(url=url, known_hash=known_hash)
+        return str(fake / "whatever")
+
+    monkeypatch.setattr(data, "__file__", str(fake / "site" / "pkg" / "fhslam" / "data.py"))
+    monkeypatch.setattr(pooch, "retrieve", retrieve)
+    find_dataset("aces", kind="relations", download=True)
+    assert seen == {
+        "url": "https://raw.githubusercontent.com/INESCTEC/ricoslam/"
+        "52bfaa91c8e5e56f119265d409b1692ca29d48d2/"
+        "inesctec_mrdt_slam_2d_datasets/data/aces.relations",
+        "known_hash": "sha256:11a15800a751b6f9413078a021d49c7cda85a768c2a465433b4fae7ef57b03d5",
+    }
+
+
+def test_verify_checks_sha256(fake, monkeypatch):
+    shared = fake / "work" / "shared" / "data"
+    log = _put(shared, "fake.clf", FAKE_LOG)
+    rel = _put(shared, "fake.relations", FAKE_REL)
+    assert verify("fake") == {"log": log, "relations": rel}
+    _put(shared, "fake.relations", FAKE_REL.replace(b"0.1", b"0.2"))  # same size, other bytes
+    with pytest.raises(ValueError, match="sha256"):
+        verify("fake")
+
+
+@pytest.fixture
+def real_shared():
+    if not (SHARED / "intel.orig.bag").is_file():
+        pytest.skip(f"no real data in {SHARED}: the Freiburg logs are not shipped with fhslam")
+    return SHARED
+
+
+def test_real_intel_is_found(real_shared, monkeypatch):
+    monkeypatch.delenv(data.ENV_VAR, raising=False)
+    assert find_dataset("intel") == real_shared / "intel.orig.bag"
+    assert find_dataset("intel", kind="relations") == real_shared / "intel.relations"
+
+
+def test_real_mit_csail_verifies(real_shared, monkeypatch):
+    if not (real_shared / "mit-csail.clf").is_file():
+        pytest.skip(f"no mit-csail.clf in {real_shared}")
+    monkeypatch.delenv(data.ENV_VAR, raising=False)
+    found = verify("mit-csail")
+    assert found == {
+        "log": real_shared / "mit-csail.clf",
+        "relations": real_shared / "mit-csail.relations",
+    }
+    # the hashes recorded in SOURCES.md, independently of the registry
+    expected = {
+        "log": "f40f31cf9e561cb2a0cb0ca2f4a809abb319543cd1b2875f6c8c6a0138559ca4",
+        "relations": "ffd7ebe97fa1738913931e39ca643ee0a1b67de80499b0197a3d01abad0f589d",
+    }
+    for kind, path in found.items():
+        assert hashlib.sha256(path.read_bytes()).hexdigest() == expected[kind]

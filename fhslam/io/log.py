@@ -7,7 +7,11 @@ the same on simulated and real data.
 
 from __future__ import annotations
 
+import errno
+from collections.abc import Callable
 from dataclasses import dataclass
+from os import PathLike
+from pathlib import Path
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -123,3 +127,59 @@ def is_number(token: str) -> bool:
     except ValueError:
         return False
     return True
+
+
+def read_numeric_table(
+    path: str | PathLike[str],
+    columns: str,
+    error: type[ValueError],
+    what: str,
+    check: Callable[[list[float], str], None] | None = None,
+) -> NDArray[np.float64]:
+    """Rows of a whitespace-separated text file of numbers (``#`` comments, blank lines).
+
+    Parameters
+    ----------
+    path : path-like
+    columns : str
+        The expected fields, e.g. ``"timestamp x y theta"``; each row must have as many.
+    error : type
+        The :class:`ValueError` subclass to raise, with ``"{path}:{lineno}: ..."``.
+    what : str
+        What a row is, for the message of an empty file (e.g. ``"poses"``).
+    check : callable, optional
+        ``check(row, where)`` raising ``error`` for a row that is wrong in a file-specific way.
+
+    Returns
+    -------
+    ndarray, shape (R, len(columns.split()))
+    """
+    path = Path(path)
+    if not path.is_file():
+        raise FileNotFoundError(errno.ENOENT, f"{what} file not found", str(path))
+    n = len(columns.split())
+    rows: list[list[float]] = []
+    try:
+        with path.open(encoding="utf-8") as f:
+            for lineno, line in enumerate(f, start=1):
+                fields = line.split()
+                if not fields or fields[0].startswith("#"):
+                    continue
+                where = f"{path}:{lineno}"
+                if len(fields) != n:
+                    raise error(f"{where}: expected {n} fields '{columns}', found {len(fields)}")
+                try:
+                    row = [float(v) for v in fields]
+                except ValueError:
+                    bad = next(v for v in fields if not is_number(v))
+                    raise error(f"{where}: non-numeric value {bad!r}") from None
+                if not all(np.isfinite(row)):
+                    raise error(f"{where}: non-finite value in {fields}")
+                if check is not None:
+                    check(row, where)
+                rows.append(row)
+    except UnicodeDecodeError as e:
+        raise error(f"{path}: not a text file ({e.reason})") from None
+    if not rows:
+        raise error(f"{path}: no {what} found")
+    return np.array(rows)

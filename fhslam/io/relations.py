@@ -12,14 +12,12 @@ R. Kümmerle, B. Steder, C. Dornhege, M. Ruhnke, G. Grisetti, C. Stachniss, A. K
 
 from __future__ import annotations
 
-import errno
 from os import PathLike
-from pathlib import Path
 
 import numpy as np
 from numpy.typing import NDArray
 
-from fhslam.io.log import is_number
+from fhslam.io.log import read_numeric_table
 
 PLANAR_TOL = 1e-6
 """Largest ``|z|``, ``|roll|``, ``|pitch|`` accepted: the relations metric here is 2-D."""
@@ -58,38 +56,14 @@ def read_relations(
         non-finite value, or a non-planar relation (``|z|``, ``|roll|`` or ``|pitch|``
         above 1e-6); ``"{path}: ..."`` for a file without relations or not text.
     """
-    path = Path(path)
-    if not path.is_file():
-        raise FileNotFoundError(errno.ENOENT, "relations file not found", str(path))
-    rows: list[list[float]] = []
-    try:
-        with path.open(encoding="utf-8") as f:
-            for lineno, line in enumerate(f, start=1):
-                fields = line.split()
-                if not fields or fields[0].startswith("#"):
-                    continue
-                where = f"{path}:{lineno}"
-                if len(fields) != 8:
-                    raise RelationsFormatError(
-                        f"{where}: expected 8 fields '{_FIELDS}', found {len(fields)}"
-                    )
-                try:
-                    row = [float(v) for v in fields]
-                except ValueError:
-                    bad = next(v for v in fields if not is_number(v))
-                    raise RelationsFormatError(f"{where}: non-numeric value {bad!r}") from None
-                if not all(np.isfinite(row)):
-                    raise RelationsFormatError(f"{where}: non-finite value in {fields}")
-                for name, value in zip(("z", "roll", "pitch"), row[4:7], strict=True):
-                    if abs(value) > PLANAR_TOL:
-                        raise RelationsFormatError(
-                            f"{where}: {name} = {value:g} is not 0: only planar (2-D) "
-                            "relations are supported (|z|, |roll|, |pitch| <= 1e-6)"
-                        )
-                rows.append(row)
-    except UnicodeDecodeError as e:
-        raise RelationsFormatError(f"{path}: not a text file ({e.reason})") from None
-    if not rows:
-        raise RelationsFormatError(f"{path}: no relations found")
-    a = np.array(rows)
+
+    def planar(row: list[float], where: str) -> None:
+        for name, value in zip(("z", "roll", "pitch"), row[4:7], strict=True):
+            if abs(value) > PLANAR_TOL:
+                raise RelationsFormatError(
+                    f"{where}: {name} = {value:g} is not 0: only planar (2-D) "
+                    "relations are supported (|z|, |roll|, |pitch| <= 1e-6)"
+                )
+
+    a = read_numeric_table(path, _FIELDS, RelationsFormatError, "relations", planar)
     return a[:, 0], a[:, 1], a[:, [2, 3, 7]]

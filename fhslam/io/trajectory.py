@@ -6,7 +6,6 @@ Numbers are written with Python's shortest round-trip ``repr``, so a file reads 
 
 from __future__ import annotations
 
-import errno
 from collections.abc import Iterable
 from os import PathLike
 from pathlib import Path
@@ -14,7 +13,7 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from fhslam.io.log import is_number
+from fhslam.io.log import read_numeric_table
 
 
 class TrajectoryFormatError(ValueError):
@@ -79,32 +78,5 @@ def read_trajectory(path: str | PathLike[str]) -> tuple[NDArray[np.float64], NDA
         ``"{path}:{lineno}: ..."`` for a line without exactly 4 fields, a non-numeric or
         non-finite value, or ``"{path}: ..."`` for a file without poses.
     """
-    path = Path(path)
-    if not path.is_file():
-        raise FileNotFoundError(errno.ENOENT, "trajectory file not found", str(path))
-    rows: list[list[float]] = []
-    try:
-        with path.open(encoding="utf-8") as f:
-            for lineno, line in enumerate(f, start=1):
-                fields = line.split()
-                if not fields or fields[0].startswith("#"):
-                    continue
-                where = f"{path}:{lineno}"
-                if len(fields) != 4:
-                    raise TrajectoryFormatError(
-                        f"{where}: expected 4 fields 'timestamp x y theta', found {len(fields)}"
-                    )
-                try:
-                    row = [float(v) for v in fields]
-                except ValueError:
-                    bad = next(v for v in fields if not is_number(v))
-                    raise TrajectoryFormatError(f"{where}: non-numeric value {bad!r}") from None
-                if not all(np.isfinite(row)):
-                    raise TrajectoryFormatError(f"{where}: non-finite value in {fields}")
-                rows.append(row)
-    except UnicodeDecodeError as e:
-        raise TrajectoryFormatError(f"{path}: not a text file ({e.reason})") from None
-    if not rows:
-        raise TrajectoryFormatError(f"{path}: no poses found")
-    a = np.array(rows)
+    a = read_numeric_table(path, "timestamp x y theta", TrajectoryFormatError, "poses")
     return a[:, 0], a[:, 1:]

@@ -198,6 +198,8 @@ class StepResult:
     n_matched: int
     n_added: int
     corrected: bool
+    lines: list[Line] = field(default_factory=list, repr=False)
+    """The scan's lines in the robot frame (Loop 1's output)."""
 
 
 @dataclass
@@ -236,6 +238,8 @@ class FastHoughSLAM:
             None if initial_pose is None else as_pose(initial_pose, "initial_pose")
         )
         self._last_odometry: NDArray[np.float64] | None = None
+        self._ends_of: list[Line] = []  # the reference lines _end_array was built from
+        self._end_array = np.zeros((0, 4))
 
     def predict(self, odometry: ArrayLike) -> NDArray[np.float64]:
         """Move the pose estimate by the odometry increment since the last step."""
@@ -263,15 +267,18 @@ class FastHoughSLAM:
         observed = p.extractor(points) if p.extractor else extract_lines(points, p.extraction)
         if not self.references:
             added = self._add_references(observed, pose, np.full(len(observed), -1))
-            return StepResult(pose.copy(), len(observed), 0, added, False)
+            return StepResult(pose.copy(), len(observed), 0, added, False, observed)
+        # Only reference lines within reach can pass conditions (c) and (d): preselect them.
+        near = self._nearby(pose, observed)
+        refs = [self.references[j] for j in near]
         corrected = False
         world = transform_lines(observed, pose)
         for _ in range(2):  # associate at the prediction, calibrate, re-associate
-            match = match_lines(world, self.references, p.matching, pose)
+            match = match_lines(world, refs, p.matching, pose)
             pairs = [(i, int(j)) for i, j in enumerate(match) if j >= 0]
             cal = calibrate_pose(
                 observed,
-                self.references,
+                refs,
                 pairs,
                 pose,
                 p.iterations,
@@ -288,16 +295,51 @@ class FastHoughSLAM:
             world = transform_lines(observed, pose)
         self.pose = pose
         # Re-place the lines with the calibrated pose; merge the matched ones into the map.
-        match = match_lines(world, self.references, p.matching, pose)
+        match = match_lines(world, refs, p.matching, pose)
+        match = np.where(match >= 0, near[np.maximum(match, 0)], -1) if len(near) else match
         for ln, j in zip(world, match, strict=True):
             if j >= 0:
                 ref = self.references[j]
                 off = np.abs(signed_distance(np.array([ln.sp, ln.ep]), ref.rho, ref.theta))
                 if off.max() <= p.max_merge_residual:
-                    self.references[j] = merge(ref, ln)
+                    self._set_reference(j, merge(ref, ln))
         added = self._add_references(observed, pose, match)
         n_matched = int((match >= 0).sum())
-        return StepResult(pose.copy(), len(observed), n_matched, added, corrected)
+        return StepResult(pose.copy(), len(observed), n_matched, added, corrected, observed)
+
+    def _ends(self) -> NDArray[np.float64]:
+        """Endpoints (K, 4) of the reference lines, cached; rebuilt if the list was changed
+        from outside."""
+        refs = self.references
+        if len(self._ends_of) != len(refs) or any(
+            a is not b for a, b in zip(self._ends_of, refs, strict=True)
+        ):
+            self._ends_of = list(refs)
+            self._end_array = np.array([[*ln.sp, *ln.ep] for ln in refs]).reshape(-1, 4)
+        return self._end_array
+
+    def _set_reference(self, j: int, line: Line) -> None:
+        self._ends()  # sync the cache first
+        self.references[j] = line
+        self._ends_of[j] = line
+        self._end_array[j] = [*line.sp, *line.ep]
+
+    def _nearby(self, pose: NDArray[np.float64], observed: Sequence[Line]) -> NDArray[np.intp]:
+        """Indices of the reference lines that can match one of ``observed`` (robot frame):
+        a matching reference has a point within ``max_distance`` (+ any allowed gap) of an
+        observed segment, so within that of the farthest observed endpoint's range."""
+        ends = self._ends()
+        if not observed or len(ends) == 0:
+            return np.zeros(0, dtype=np.intp)
+        m = self.params.matching
+        reach = max(max(np.hypot(*ln.sp), np.hypot(*ln.ep)) for ln in observed)
+        reach += m.max_distance + max(0.0, -m.min_overlap) + 1e-6
+        a, d = ends[:, :2] - pose[:2], ends[:, 2:] - ends[:, :2]
+        t = np.clip(
+            -np.einsum("ij,ij->i", a, d) / np.maximum(np.einsum("ij,ij->i", d, d), 1e-18), 0, 1
+        )
+        dist = np.hypot(a[:, 0] + t * d[:, 0], a[:, 1] + t * d[:, 1])
+        return np.flatnonzero(dist <= reach)
 
     def _add_references(self, observed: Sequence[Line], pose: NDArray, match: NDArray) -> int:
         p = self.params
@@ -309,7 +351,11 @@ class FastHoughSLAM:
             ],
             pose,
         )
+        ends = self._ends()  # sync the cache, then extend both
         self.references.extend(new)
+        self._ends_of.extend(new)
+        rows = np.array([[*ln.sp, *ln.ep] for ln in new]).reshape(-1, 4)
+        self._end_array = np.vstack([ends, rows])
         return len(new)
 
     def run(self, log, progress: bool = False) -> SlamResult:
@@ -327,9 +373,10 @@ class FastHoughSLAM:
         )
 
 
-METHODS = ("fht", "classical", "ekf", "odometry")
-"""SLAM methods: FH-SLAM, FH-SLAM with OpenCV's classical Hough as Loop 1, the EKF
-line-SLAM baseline, and dead reckoning."""
+METHODS = ("fht", "graph", "classical", "ekf", "odometry")
+"""SLAM methods: FH-SLAM (the paper's procedure), FH-SLAM on a pose graph with loop closures
+(:mod:`fhslam.graphslam`, for long real logs), FH-SLAM with OpenCV's classical Hough as
+Loop 1, the EKF line-SLAM baseline, and dead reckoning."""
 
 
 def run_slam(
@@ -352,6 +399,11 @@ def run_slam(
         )
     if method == "fht":
         return FastHoughSLAM(params).run(log, progress=progress)
+    if method == "graph":
+        from fhslam.graphslam import GraphFastHoughSLAM, GraphSlamParams
+
+        gp = GraphSlamParams() if params is None else GraphSlamParams(front_end=params)
+        return GraphFastHoughSLAM(gp).run(log, progress=progress)
     if method == "classical":
         from fhslam.baselines import hough_opencv_pointset
 

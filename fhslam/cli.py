@@ -94,6 +94,9 @@ def _evaluate(args: argparse.Namespace) -> None:
             raise ValueError(f"{', '.join(given)}: only with --truth, not with --relations")
         max_diff = 0.001 if args.max_diff is None else args.max_diff
         t_est, est = read_trajectory(args.trajectory)
+        from fhslam.data import find_dataset
+
+        args.relations = find_dataset(args.relations, kind="relations")
         t1, t2, rel = read_relations(args.relations)
         try:
             rerr = metrics.relations_error(t_est, est, t1, t2, rel, max_diff=max_diff)
@@ -196,22 +199,8 @@ def _reproduce(args: argparse.Namespace) -> None:
         print(path)
 
 
-def load_log(source: str, scan_topic=None, odom_topic=None, download=False):
-    """A log from a CARMEN file, a ROS bag, or a dataset name (``intel``, ``aces``, ...)."""
-    from fhslam.data import DATASETS, find_dataset
-    from fhslam.io import is_bag, read_bag, read_carmen
-
-    path = Path(source)
-    if not path.exists() and source in DATASETS:
-        path = find_dataset(source, "log", download=download)
-    if is_bag(path):
-        return read_bag(path, scan_topic=scan_topic, odom_topic=odom_topic)
-    if scan_topic or odom_topic:
-        raise ValueError(f"{path}: --scan-topic/--odom-topic apply to ROS bags only")
-    return read_carmen(path)
-
-
 def _slam(args: argparse.Namespace) -> None:
+    from fhslam.data import load_log
     from fhslam.io import write_map, write_trajectory
     from fhslam.slam import run_slam
 
@@ -273,10 +262,12 @@ def build_parser() -> argparse.ArgumentParser:
     )
     p.add_argument(
         "--method",
-        choices=("fht", "classical", "ekf", "odometry"),
+        choices=("fht", "graph", "classical", "ekf", "odometry"),
         default="fht",
-        help="fht: fast-Hough SLAM (default); classical: the same with OpenCV's classical "
-        "Hough as Loop 1; ekf: EKF line SLAM (filterpy); odometry: dead reckoning",
+        help="fht: fast-Hough SLAM, the paper's procedure (default); graph: the same as the "
+        "front end of a pose graph with scan-matched keyframes and loop closures (for long "
+        "real logs such as intel); classical: fht with OpenCV's classical Hough as Loop 1; "
+        "ekf: EKF line SLAM (filterpy); odometry: dead reckoning",
     )
     p.add_argument("--trajectory", required=True, type=Path, help="output: timestamp x y theta")
     p.add_argument("--map", type=Path, help="output map JSON (reference lines)")
@@ -309,8 +300,8 @@ def build_parser() -> argparse.ArgumentParser:
     reference.add_argument("--truth", type=Path, help="ground-truth trajectory file")
     reference.add_argument(
         "--relations",
-        type=Path,
-        help="benchmark relations file (timestamp1 timestamp2 x y z roll pitch yaw)",
+        help="benchmark relations file (timestamp1 timestamp2 x y z roll pitch yaw), or a "
+        "dataset name (intel, aces, ...) to use its relations",
     )
     p.add_argument(
         "--world", help="built-in world ('paper', 'random:SEED') or world JSON file (--truth)"

@@ -39,6 +39,7 @@ __all__ = [
     "DatasetNotFoundError",
     "find_dataset",
     "is_held_out",
+    "load_log",
     "search_dirs",
     "verify",
 ]
@@ -338,3 +339,27 @@ def verify(name: str, download: bool = False) -> dict[str, Path]:
             raise ValueError(f"{path}: sha256 {digest}, but {f.name} has sha256 {f.sha256}")
         found[kind] = path
     return found
+
+
+def load_log(
+    source: str | os.PathLike[str],
+    scan_topic: str | None = None,
+    odom_topic: str | None = None,
+    download: bool = False,
+):
+    """A :class:`fhslam.io.Log` from a CARMEN file, a ROS bag, or a dataset name.
+
+    Examples
+    --------
+    >>> log = load_log("intel")     # the bag found by :func:`find_dataset`  # doctest: +SKIP
+    """
+    from fhslam.io import is_bag, read_bag, read_carmen
+
+    path = Path(source)
+    if not path.exists() and str(source) in DATASETS:
+        path = find_dataset(str(source), "log", download=download)
+    if is_bag(path):
+        return read_bag(path, scan_topic=scan_topic, odom_topic=odom_topic)
+    if scan_topic or odom_topic:
+        raise ValueError(f"{path}: --scan-topic/--odom-topic apply to ROS bags only")
+    return read_carmen(path)

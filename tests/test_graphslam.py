@@ -1,0 +1,95 @@
+"""FH-SLAM on a pose graph: simulated worlds, real logs (Intel, held-out ACES), bad input."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from fhslam.graphslam import GraphFastHoughSLAM, GraphSlamParams
+from fhslam.metrics import ate
+from fhslam.sim import OdometryNoise, degrade, load_world, simulate
+from fhslam.slam import run_slam
+
+
+@pytest.fixture(scope="module")
+def three_laps():
+    """A held-out world driven three times with 2-6 m of odometry drift."""
+    return simulate(load_world("random:109"), seed=0, odometry=OdometryNoise.drifting(), laps=3)
+
+
+def test_loops_are_closed_and_the_drift_removed(three_laps):
+    log = three_laps
+    slam = GraphFastHoughSLAM()
+    r = slam.run(log)
+    assert len(slam.loops) >= 20  # measured 105
+    assert all(lc.score >= slam.params.loop_min_score for lc in slam.loops)
+    assert all(lc.new - lc.old >= slam.params.loop_min_gap for lc in slam.loops)
+    odometry = ate(log.odometry, log.truth).rmse  # 2.3 m
+    assert ate(r.poses, log.truth).rmse <= min(0.05, 0.05 * odometry)  # measured 1.3 cm
+    assert len(r.poses) == len(log.timestamps) and len(r.map) > 0
+    np.testing.assert_array_equal(r.timestamps, log.timestamps)
+
+
+def test_same_log_same_numbers(three_laps):
+    a = run_slam(three_laps, "graph").poses
+    b = run_slam(three_laps, "graph").poses
+    np.testing.assert_array_equal(a, b)
+
+
+def test_dropped_scans_and_clutter(three_laps):
+    """10% of the scans dropped, 5% clutter returns: every scan still gets a pose."""
+    log = degrade(three_laps, drop_fraction=0.1, clutter_fraction=0.05, seed=1)
+    r = run_slam(log, "graph")
+    assert np.isfinite(r.poses).all() and len(r.poses) == len(log.timestamps)
+    assert ate(r.poses, log.truth).rmse <= 0.10  # measured 1.5 cm
+
+
+def test_without_loop_closures_no_loop_edges(three_laps):
+    slam = GraphFastHoughSLAM(GraphSlamParams(loop_candidates=0))
+    slam.run(three_laps)
+    assert slam.loops == [] and set(slam.graph.edges[3]) == {"odometry"}
+
+
+@pytest.mark.parametrize(
+    ("field", "value", "message"),
+    [
+        ("keyframe_distance", 0.0, "keyframe_distance must be > 0"),
+        ("cloud_voxel", -1.0, "cloud_voxel must be > 0"),
+        ("loop_min_score", 1.5, r"loop_min_score must be in \[0, 1\]"),
+        ("submap_keyframes", 0, "submap_keyframes and loop_min_gap must be >= 1"),
+    ],
+)
+def test_bad_parameters_are_named(field, value, message):
+    with pytest.raises(ValueError, match=message):
+        GraphSlamParams(**{field: value})
+
+
+# --------------------------------------------------------------------------- real logs
+
+
+def _relations_error(real_data, name):
+    from fhslam.data import load_log
+    from fhslam.io import read_relations
+    from fhslam.metrics import relations_error
+
+    log = load_log(real_data / (f"{name}.orig.bag"))
+    r = run_slam(log, "graph")
+    return relations_error(r.timestamps, r.poses, *read_relations(real_data / f"{name}.relations"))
+
+
+def test_intel_relations_error_meets_issue_5(real_data):
+    """The whole Intel log: issue 5 asks for <= 0.50 m (aim 0.05 m); measured 0.041 m,
+    0.82 deg, over all 2984 relations (raw odometry: 7.38 m)."""
+    e = _relations_error(real_data, "intel")
+    assert e.n_used == e.n_total == 2984
+    assert e.trans_mean <= 0.05
+    assert e.rot_mean_deg <= 1.0
+
+
+def test_held_out_aces_relations_error_meets_issue_5(real_data):
+    """ACES was never run while the method was developed and tuned (held out); issue 5
+    asks for <= 0.30 m (raw odometry 0.55 m). Measured once, with the final defaults:
+    0.161 m."""
+    e = _relations_error(real_data, "aces")
+    assert e.n_used == e.n_total
+    assert e.trans_mean <= 0.30

@@ -1,0 +1,88 @@
+"""Correlative scan matching: known offsets recovered, corridors, thin clouds, bad input."""
+
+from __future__ import annotations
+
+import itertools
+
+import numpy as np
+import pytest
+
+from fhslam.geometry import compose, inverse, transform_points
+from fhslam.scanmatch import LikelihoodGrid, match_clouds, voxel_downsample
+
+
+def _room(step=0.02):
+    """A 6 x 4 m room with a 1 x 0.5 m box: points every 2 cm (in the room frame)."""
+
+    def seg(a, b):
+        n = int(np.hypot(*np.subtract(b, a)) / step) + 1
+        return np.linspace(a, b, n)
+
+    corners = [(0, 0), (6, 0), (6, 4), (0, 4), (0, 0)]
+    walls = [seg(a, b) for a, b in itertools.pairwise(corners)]
+    box = [(2, 1), (3, 1), (3, 1.5), (2, 1.5), (2, 1)]
+    walls += [seg(a, b) for a, b in itertools.pairwise(box)]
+    return np.vstack(walls)
+
+
+@pytest.mark.parametrize("offset", [(0.4, -0.3, 8.0), (-0.9, 0.6, -12.0), (0.0, 0.0, 0.0)])
+def test_a_known_offset_is_recovered(offset):
+    room = _room()
+    target_pose = np.array([1.0, 1.2, 0.3])  # the target frame in the room
+    query_pose = np.array([3.5, 2.0, -0.4])  # the query frame in the room
+    target = transform_points(inverse(target_pose), room)
+    query = transform_points(inverse(query_pose), room)
+    truth = compose(inverse(target_pose), query_pose)  # query frame in the target frame
+    guess = compose(truth, [offset[0], offset[1], np.radians(offset[2])])
+    m = match_clouds(target, query, guess, window=1.0, window_deg=15.0)
+    assert np.hypot(*(m.pose[:2] - truth[:2])) <= 0.02  # one fine cell
+    assert abs(np.degrees(m.pose[2] - truth[2])) <= 0.2  # two fine angle steps
+    assert m.score > 0.9
+    assert m.coarse_score >= m.guess_score
+
+
+def test_along_a_corridor_the_guess_is_kept():
+    """Two parallel walls give no information along them: of the equal scores the prior
+    picks the one nearest the guess, not the window's corner."""
+    x = np.arange(-10, 10, 0.02)
+    corridor = np.vstack([np.column_stack([x, np.full_like(x, 1.0)]),
+                          np.column_stack([x, np.full_like(x, -1.0)])])  # fmt: skip
+    query = corridor[np.abs(corridor[:, 0]) < 4]
+    m = match_clouds(corridor, query, [0.3, 0.05, 0.0], window=1.0, window_deg=5.0)
+    assert abs(m.pose[0] - 0.3) <= 0.03  # kept along the axis
+    assert abs(m.pose[1]) <= 0.02  # corrected across it
+    assert abs(m.pose[2]) <= np.radians(0.2)
+
+
+def test_thin_clouds_score_zero_and_keep_the_guess():
+    room = _room()
+    m = match_clouds(room, room[:5], [0.1, 0.2, 0.3])
+    assert m.score == 0.0 and m.coarse_score == 0.0
+    np.testing.assert_array_equal(m.pose, [0.1, 0.2, 0.3])
+    far = match_clouds(room, room + 100.0, [0.0, 0.0, 0.0])  # no target near the guess
+    assert far.score == 0.0
+
+
+def test_bad_input_is_named():
+    room = _room()
+    bad = room.copy()
+    bad[3] = np.nan
+    with pytest.raises(ValueError, match="query contains 1 non-finite"):
+        match_clouds(room, bad, [0, 0, 0])
+    with pytest.raises(ValueError, match="guess must be finite"):
+        match_clouds(room, room, [0, np.inf, 0])
+    with pytest.raises(ValueError, match="must not be empty"):
+        LikelihoodGrid.build(np.zeros((0, 2)), 0.1, 0.1, 0.5)
+    with pytest.raises(ValueError, match="size must be > 0"):
+        voxel_downsample(room, 0.0)
+
+
+def test_grid_score_and_voxel_downsample():
+    room = _room()
+    grid = LikelihoodGrid.build(room, 0.02, 0.04, 0.5)
+    assert grid.score(room, [0, 0, 0]) > 0.95
+    assert grid.score(room, [0.2, 0, 0]) < grid.score(room, [0.02, 0, 0])
+    v = voxel_downsample(room, 0.1)
+    cells = np.floor(v / 0.1).astype(int)
+    assert len(np.unique(cells, axis=0)) == len(v)  # one point per cell
+    assert len(np.unique(np.floor(room / 0.1).astype(int), axis=0)) == len(v)  # every cell

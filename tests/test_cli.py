@@ -281,7 +281,7 @@ def test_slam_unknown_method_is_a_usage_error(tmp_path):
     assert r.returncode == 2 and "invalid choice" in r.stderr
 
 
-@pytest.mark.parametrize("method", ["ekf", "classical"])
+@pytest.mark.parametrize("method", ["ekf", "classical", "graph"])
 def test_slam_methods_through_the_command_line(tmp_path, method):
     log, truth = tmp_path / "p.clf", tmp_path / "truth.txt"
     main(
@@ -333,3 +333,10 @@ def test_slam_on_a_dataset_name_then_relations(tmp_path, real_data, monkeypatch)
     out = json.loads(r.stdout)
     assert out["relations_used"] == out["relations_total"] == 1172
     assert 1.0 < out["relations_trans_mean"] < 3.0  # raw odometry: 1.68 m
+    # the relations by dataset name give the same numbers
+    by_name = run("evaluate", str(traj), "--relations", "mit-csail", "--json")
+    assert json.loads(by_name.stdout) == out
+    # another dataset's relations share no timestamps: one line, exit 2
+    r = run("evaluate", str(traj), "--relations", "aces")
+    assert r.returncode == 2 and "no relation can be used" in r.stderr
+    assert r.stderr.count("\n") == 1

@@ -238,7 +238,8 @@ class FastHoughSLAM:
             None if initial_pose is None else as_pose(initial_pose, "initial_pose")
         )
         self._last_odometry: NDArray[np.float64] | None = None
-        self._ends_of: list[Line] = []  # the reference lines _end_array was built from
+        self._ends_of: list[int] = []  # ids of the reference lines _end_array holds
+        self._ends_keep: list[Line] = []
         self._end_array = np.zeros((0, 4))
 
     def predict(self, odometry: ArrayLike) -> NDArray[np.float64]:
@@ -309,19 +310,18 @@ class FastHoughSLAM:
 
     def _ends(self) -> NDArray[np.float64]:
         """Endpoints (K, 4) of the reference lines, cached; rebuilt if the list was changed
-        from outside."""
-        refs = self.references
-        if len(self._ends_of) != len(refs) or any(
-            a is not b for a, b in zip(self._ends_of, refs, strict=True)
-        ):
-            self._ends_of = list(refs)
-            self._end_array = np.array([[*ln.sp, *ln.ep] for ln in refs]).reshape(-1, 4)
+        from outside (checked once per step, in :meth:`_nearby`)."""
+        ids = [*map(id, self.references)]
+        if ids != self._ends_of:
+            self._ends_of = ids
+            self._ends_keep = list(self.references)  # alive, so their ids stay unique
+            self._end_array = np.array([[*ln.sp, *ln.ep] for ln in self.references]).reshape(-1, 4)
         return self._end_array
 
     def _set_reference(self, j: int, line: Line) -> None:
-        self._ends()  # sync the cache first
         self.references[j] = line
-        self._ends_of[j] = line
+        self._ends_of[j] = id(line)
+        self._ends_keep[j] = line
         self._end_array[j] = [*line.sp, *line.ep]
 
     def _nearby(self, pose: NDArray[np.float64], observed: Sequence[Line]) -> NDArray[np.intp]:
@@ -353,7 +353,8 @@ class FastHoughSLAM:
         )
         ends = self._ends()  # sync the cache, then extend both
         self.references.extend(new)
-        self._ends_of.extend(new)
+        self._ends_of.extend(map(id, new))
+        self._ends_keep.extend(new)
         rows = np.array([[*ln.sp, *ln.ep] for ln in new]).reshape(-1, 4)
         self._end_array = np.vstack([ends, rows])
         return len(new)

@@ -133,6 +133,13 @@ def test_bench_table_has_every_extractor(capsys):
         "OpenCV HoughLinesP (raster)",
     ):
         assert name in out
+    slam_rows = [
+        ln.split()
+        for ln in out.splitlines()
+        if ln.split()[:1] in (["fht"], ["graph"], ["classical"], ["ekf"])
+    ]
+    assert [r[0] for r in slam_rows] == ["fht", "graph", "classical", "ekf"]
+    assert all(float(r[1]) > 0 for r in slam_rows)  # steps per second
 
 
 # ----------------------------------------------------------------------------- evaluate

@@ -13,7 +13,9 @@ from contextlib import contextmanager
 import matplotlib.pyplot as plt
 import numpy as np
 from matplotlib.axes import Axes
+from matplotlib.cbook import normalize_kwargs
 from matplotlib.collections import LineCollection
+from matplotlib.lines import Line2D
 from matplotlib.patches import Arc, Circle, FancyArrowPatch, Polygon, Wedge
 from numpy.typing import ArrayLike
 
@@ -90,14 +92,22 @@ def plot_clusters(points: ArrayLike, labels: ArrayLike, ax: Axes | None = None) 
     return ax
 
 
-def plot_lines(lines: Sequence[Line], ax: Axes | None = None, labels: bool = False, **kw) -> Axes:
-    """Draw line segments from ``sp`` to ``ep`` with their endpoints marked."""
+def plot_lines(
+    lines: Sequence[Line],
+    ax: Axes | None = None,
+    labels: bool = False,
+    markers: bool = True,
+    **kw,
+) -> Axes:
+    """Draw line segments from ``sp`` to ``ep``, with their endpoints marked unless
+    ``markers=False`` (for maps of hundreds of lines); ``kw`` go to ``Axes.plot``."""
     ax = _axes(ax)
-    style = {"color": LINE_COLOR, "linewidth": 2.5, "zorder": 4} | kw
+    style = {"color": LINE_COLOR, "linewidth": 2.5, "zorder": 4} | normalize_kwargs(kw, Line2D)
     for i, line in enumerate(lines):
         xs, ys = zip(line.sp, line.ep, strict=True)
         ax.plot(xs, ys, solid_capstyle="round", **(style | {"label": None}))
-        ax.plot(xs, ys, "o", ms=4, color=style["color"], zorder=5)
+        if markers:
+            ax.plot(xs, ys, "o", ms=4, color=style["color"], zorder=5)
         if labels:
             ax.annotate(f"l{i + 1}", line.midpoint, xytext=(3, 3), textcoords="offset points")
     if lines and "label" in kw:
@@ -121,7 +131,7 @@ def plot_trajectory(poses: ArrayLike, ax: Axes | None = None, **kw) -> Axes:
     """Draw a trajectory, shape (T, 3) or (T, 2)."""
     ax = _axes(ax)
     p = np.asarray(poses, dtype=float)
-    ax.plot(p[:, 0], p[:, 1], **({"linewidth": 1.5} | kw))
+    ax.plot(p[:, 0], p[:, 1], **({"linewidth": 1.5} | normalize_kwargs(kw, Line2D)))
     return ax
 
 

@@ -122,3 +122,23 @@ def test_figures_are_deterministic():
             np.testing.assert_array_equal(la.ep, lb.ep)
     (l1, p1), (l2, p2) = figures.line_attributes_example(), figures.line_attributes_example()
     assert p1 == p2 and l1.rho == l2.rho and l1.theta == l2.theta
+
+
+def test_plot_lines_and_trajectory_take_matplotlib_aliases():
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from fhslam.lines import line_from_points
+    from fhslam.plotting import plot_lines, plot_trajectory
+
+    fig, ax = plt.subplots()
+    line = line_from_points(np.array([[0.0, 0.0], [1.0, 0.0], [2.0, 0.0]]))
+    plot_lines([line, line], ax=ax, lw=0.5, markers=False)
+    assert len(ax.lines) == 2 and ax.lines[0].get_linewidth() == 0.5  # no endpoint markers
+    plot_lines([line], ax=ax)
+    assert len(ax.lines) == 4  # one segment + its endpoint markers
+    plot_trajectory(np.zeros((3, 3)), ax=ax, lw=0.3)
+    assert ax.lines[-1].get_linewidth() == 0.3
+    plt.close(fig)

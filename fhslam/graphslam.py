@@ -30,8 +30,10 @@ Optionally (``GraphSlamParams(predict=True)``) each scan is first matched agains
 keyframe clouds and the match replaces a clearly worse odometry increment before the front
 end sees it. This rescues MIT CSAIL (whose odometry heading is poor: 1.40 m → 0.040 m mean
 relation error) but derails Intel at an odometry glitch (0.041 m → 2.1 m), so it is off by
-default: an open problem, shown in notebook 08. ``method="graph"`` in :func:`fhslam.slam.run_slam` and
-``fhslam slam --method graph`` run it; ``method="fht"`` stays the paper's procedure.
+default: an open problem, shown in notebook 08.
+
+``method="graph"`` in :func:`fhslam.slam.run_slam` and ``fhslam slam --method graph`` run it;
+``method="fht"`` stays the paper's procedure.
 """
 
 from __future__ import annotations
@@ -44,6 +46,7 @@ from tqdm.auto import tqdm
 
 from fhslam.extraction import scan_to_points
 from fhslam.geometry import as_pose, compose, relative, signed_distance, transform_points
+from fhslam.io.log import scan_of
 from fhslam.lines import Line, transform_lines
 from fhslam.matching import match_lines, merge
 from fhslam.posegraph import PoseGraph
@@ -392,7 +395,7 @@ class GraphFastHoughSLAM:
             range(n), desc=f"FH-SLAM graph {getattr(log, 'name', '')}", unit="scan",
             disable=not progress,
         ):  # fmt: skip
-            self.step(log.ranges[k], log.angles, log.odometry[k], log.max_range)
+            self.step(*scan_of(log, k), log.odometry[k], log.max_range)
         self.finish()
         poses = self.poses
         steps = [replace(s, pose=q) for s, q in zip(self._steps, poses, strict=True)]

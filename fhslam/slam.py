@@ -27,6 +27,7 @@ from tqdm.auto import tqdm
 
 from fhslam.extraction import ExtractionParams, extract_lines, scan_to_points
 from fhslam.geometry import as_pose, compose, inverse, relative, signed_distance, wrap_angle
+from fhslam.io.log import scan_of
 from fhslam.lines import Line, transform_lines
 from fhslam.matching import MatchParams, match_lines, merge
 
@@ -367,7 +368,7 @@ class FastHoughSLAM:
         for k in tqdm(
             it, desc=f"FH-SLAM {getattr(log, 'name', '')}", unit="scan", disable=not progress
         ):
-            steps.append(self.step(log.ranges[k], log.angles, log.odometry[k], log.max_range))
+            steps.append(self.step(*scan_of(log, k), log.odometry[k], log.max_range))
         poses = np.array([s.pose for s in steps]).reshape(-1, 3)
         return SlamResult(
             np.asarray(log.timestamps, dtype=float), poses, list(self.references), steps

@@ -15,8 +15,10 @@ def _types():
     return get_typestore(Stores.ROS1_NOETIC)
 
 
-def write_bag(path, scans=3, odom=True, scan_topics=("/scan",), beams=181):
-    """A tiny ROS 1 bag: scans of a wall 2 m ahead, odometry moving 0.1 m per scan."""
+def write_bag(path, scans=3, odom=True, scan_topics=("/scan",), beams=181, interlaced=False):
+    """A tiny ROS 1 bag: scans of a wall 2 m ahead, odometry moving 0.1 m per scan.
+    ``interlaced``: scan k starts (k mod 4) quarter-beams later, with one beam fewer after
+    the first (as the Freiburg hospital log's laser)."""
     from rosbags.rosbag1 import Writer
 
     ts = _types()
@@ -33,10 +35,11 @@ def write_bag(path, scans=3, odom=True, scan_topics=("/scan",), beams=181):
         oc = w.add_connection("/odom", odom_t, typestore=ts) if odom else None
         for k in range(scans):
             inc = np.pi / (beams - 1)
-            a = -np.pi / 2 + inc * np.arange(beams)
+            shift = (k % 4) * inc / 4 if interlaced else 0.0
+            a = -np.pi / 2 + shift + inc * np.arange(beams - (shift > 0))
             r = np.where(np.abs(a) < 1.0, 2.0 / np.cos(a), 81.9).astype(np.float32)
             msg = T[scan_t](
-                header=header(k), angle_min=-np.pi / 2, angle_max=np.pi / 2,
+                header=header(k), angle_min=a[0], angle_max=a[-1],
                 angle_increment=inc, time_increment=0.0, scan_time=0.0, range_min=0.0,
                 range_max=80.0, ranges=r, intensities=np.zeros(0, np.float32),
             )  # fmt: skip
@@ -120,3 +123,22 @@ def test_fr079_laser_offset_from_tf_static(real_data):
     np.testing.assert_allclose(log.laser_offset, [0.04, 0.0, 0.0], atol=1e-9)  # SOURCES.md
     assert log.n_beams == 360
     np.testing.assert_allclose(np.degrees(np.diff(log.angles)), 0.5)
+
+
+def test_an_interlaced_laser_gets_per_scan_bearing_offsets(tmp_path):
+    """Scans starting a quarter beam apart (181, 180, 180, 180 beams) read into one Log
+    whose ``scan(k)`` bearings put every point back on the wall x = 2 m."""
+    from fhslam.extraction import scan_to_points
+    from fhslam.io import write_carmen
+
+    log = read_bag(write_bag(tmp_path / "i.bag", scans=6, interlaced=True))
+    inc = np.pi / 180
+    np.testing.assert_allclose(
+        log.angle_offsets, np.array([0, 0.25, 0.5, 0.75, 0, 0.25]) * inc, atol=1e-6
+    )
+    assert log.ranges.shape == (6, 181) and np.isnan(log.ranges[1, -1])
+    for k in range(6):
+        pts, _ = scan_to_points(*log.scan(k), max_range=log.max_range)
+        np.testing.assert_allclose(pts[:, 0], 2.0, atol=1e-5)
+    with pytest.raises(ValueError, match="per-scan bearing offsets"):
+        write_carmen(log, tmp_path / "i.clf")

@@ -28,6 +28,7 @@ from tqdm.auto import tqdm
 
 from fhslam.extraction import ExtractionParams, extract_lines, scan_to_points
 from fhslam.geometry import as_pose, compose, relative, wrap_angle
+from fhslam.io.log import scan_of
 from fhslam.lines import Line
 
 CHI2_2DOF_99 = 9.2103
@@ -358,6 +359,6 @@ class EKFLineSLAM:
 
         poses = []
         for k in tqdm(range(len(log.timestamps)), desc="EKF", unit="scan", disable=not progress):
-            self.step(log.ranges[k], log.angles, log.odometry[k], log.max_range)
+            self.step(*scan_of(log, k), log.odometry[k], log.max_range)
             poses.append(self.pose)
         return SlamResult(np.asarray(log.timestamps, float), np.array(poses), self.landmarks(), [])

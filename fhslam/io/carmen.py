@@ -79,6 +79,11 @@ def write_carmen(log: Log, path: str | PathLike[str]) -> None:
     ValueError
         If the bearings are not evenly spaced (no CARMEN message can describe them).
     """
+    if log.angle_offsets is not None and np.any(log.angle_offsets != 0):
+        raise ValueError(
+            f"write_carmen: log {log.name!r} has per-scan bearing offsets (an interlaced "
+            "laser), which CARMEN lines cannot describe"
+        )
     n = log.n_beams
     angles = log.angles
     use_flaser = n >= 2 and np.allclose(angles, flaser_angles(n), rtol=0, atol=1e-12)

@@ -51,6 +51,10 @@ class Log:
         Pose of the laser on the robot, ``robot_T_laser`` (zero: the laser at the robot's
         origin). SLAM estimates laser poses ``odometry ⊕ laser_offset`` and reports robot
         poses.
+    angle_offsets : ndarray, shape (T,), or None
+        Per-scan offset added to ``angles``, radians (an interlaced laser whose successive
+        scans start a quarter of a beam apart, as in the Freiburg hospital log); ``None``:
+        every scan uses ``angles``. Read scans through :meth:`scan`.
     """
 
     name: str
@@ -63,6 +67,7 @@ class Log:
     hits: NDArray[np.intp] | None = None
     world: World | None = None
     laser_offset: NDArray[np.float64] | None = None
+    angle_offsets: NDArray[np.float64] | None = None
 
     def __post_init__(self) -> None:
         self.laser_offset = (
@@ -93,6 +98,13 @@ class Log:
             self.truth = np.asarray(self.truth, dtype=float)
             if self.truth.shape != (t, 3):
                 raise ValueError(f"Log.truth must have shape ({t}, 3), got {self.truth.shape}")
+        if self.angle_offsets is not None:
+            self.angle_offsets = np.asarray(self.angle_offsets, dtype=float)
+            if self.angle_offsets.shape != (t,) or not np.all(np.isfinite(self.angle_offsets)):
+                raise ValueError(
+                    f"Log.angle_offsets must be {t} finite numbers, got shape "
+                    f"{self.angle_offsets.shape}"
+                )
         if self.hits is not None:
             self.hits = np.asarray(self.hits, dtype=np.intp)
             if self.hits.shape != (t, b):
@@ -108,8 +120,11 @@ class Log:
         return len(self.angles)
 
     def scan(self, k: int) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-        """Scan ``k`` as ``(ranges (B,), angles (B,))`` in the laser frame."""
-        return self.ranges[k], self.angles
+        """Scan ``k`` as ``(ranges (B,), angles (B,))`` in the laser frame (``angles`` plus
+        the scan's ``angle_offsets`` entry, if any)."""
+        if self.angle_offsets is None:
+            return self.ranges[k], self.angles
+        return self.ranges[k], self.angles + self.angle_offsets[k]
 
     def __repr__(self) -> str:
         duration = self.timestamps[-1] - self.timestamps[0] if len(self) else 0.0
@@ -183,3 +198,10 @@ def read_numeric_table(
     if not rows:
         raise error(f"{path}: no {what} found")
     return np.array(rows)
+
+
+def scan_of(log, k: int) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """Scan ``k`` of ``log`` as ``(ranges, angles)``: :meth:`Log.scan` for a :class:`Log`,
+    ``(log.ranges[k], log.angles)`` for any other object with those attributes."""
+    scan = getattr(log, "scan", None)
+    return scan(k) if callable(scan) else (log.ranges[k], log.angles)

@@ -10,8 +10,11 @@ the converter wrote ``angle_min = -π/2`` and ``angle_increment = π/(n−1)``. 
 (``beams="carmen"``, the default) fhslam uses CARMEN's own rule instead — "if no information
 is given, assume 1.0° resolution": ``-90° + k · 1°`` for up to 181 beams and ``-90° + k · 0.5°``
 for up to 361 (for 181 and 361 beams the two rules agree). A bag whose increment is anything
-else (e.g. from ``ROBOTLASER1`` lines, which state it) is taken as it is. ``beams="bag"``
-always takes the bag's values.
+else (e.g. from ``ROBOTLASER1`` lines, which state it) is taken as it is.
+An interlaced laser, whose scans share the increment but start up to one beam apart (the
+Freiburg hospital log: four layouts a quarter degree apart, 181 or 180 beams), is read with
+the first layout's bearings and a per-scan ``Log.angle_offsets``; other mixed layouts are
+refused. ``beams="bag"`` always takes the bag's values.
 """
 
 from __future__ import annotations
@@ -117,16 +120,19 @@ def read_bag(
     try:
         scan_conns = _pick(reader, SCAN_TYPE, scan_topic, "laser scan", p)
         odom_conns = _pick(reader, ODOM_TYPE, odom_topic, "odometry", p)
-        stamps, ranges, layout, max_range = [], [], set(), 0.0
+        stamps, ranges, layout, max_range, starts = [], [], set(), 0.0, []
         for conn, _t, raw in reader.messages(connections=scan_conns):
             m = reader.deserialize(raw, conn.msgtype)
             stamps.append(m.header.stamp.sec + 1e-9 * m.header.stamp.nanosec)
             ranges.append(np.asarray(m.ranges, dtype=float))
             layout.add((round(float(m.angle_min), 6), round(float(m.angle_increment), 7)))
+            starts.append(float(m.angle_min))
             max_range = max(max_range, float(m.range_max))
         if not stamps:
             raise BagFormatError(f"{p}: topic {scan_conns[0].topic!r} holds no scans")
-        if len(layout) > 1:
+        a0, inc = min(layout)
+        interlaced = all(i == inc and 0 <= a - a0 < inc for a, i in layout)
+        if len(layout) > 1 and not interlaced:
             raise BagFormatError(f"{p}: scans with different angle layouts {sorted(layout)}")
         odo_t, odo = [], []
         for conn, _t, raw in reader.messages(connections=odom_conns):
@@ -144,7 +150,6 @@ def read_bag(
     rr = np.full((len(ranges), n), np.nan)
     for k, r in enumerate(ranges):
         rr[k, : len(r)] = r  # shorter scans of the same layout: missing beams are invalid
-    ((a0, inc),) = layout
     converted = abs(inc - np.pi / (n - 1)) < 1e-6
     angles = carmen_beam_angles(n) if beams == "carmen" and converted else a0 + inc * np.arange(n)
     t = np.asarray(stamps)
@@ -157,6 +162,7 @@ def read_bag(
         odometry=_interpolate_poses(np.asarray(odo_t), np.asarray(odo), t[order], p),
         max_range=max_range,
         laser_offset=offset,
+        angle_offsets=(np.asarray(starts)[order] - a0) if len(layout) > 1 else None,
     )
 
 

@@ -228,25 +228,16 @@ def test_evaluate_map_of_the_true_walls(truth_file, tmp_path, capsys):
     assert r.stderr.count("\n") == 1 and "Traceback" not in r.stderr
 
 
+def _simulate_drifting(tmp_path, world):
+    """``fhslam simulate WORLD`` with drifting odometry, 3 laps: the log and truth paths."""
+    log, truth = tmp_path / "sim.clf", tmp_path / "truth.txt"
+    argv = ["simulate", world, "--odometry", "drifting", "--laps", "3"]
+    assert main([*argv, "--log", str(log), "--truth", str(truth)]) == 0
+    return log, truth
+
+
 def test_slam_then_evaluate_beats_odometry(tmp_path):
-    log, truth = tmp_path / "r.clf", tmp_path / "truth.txt"
-    assert (
-        main(
-            [
-                "simulate",
-                "random:105",
-                "--odometry",
-                "drifting",
-                "--laps",
-                "3",
-                "--log",
-                str(log),
-                "--truth",
-                str(truth),
-            ]
-        )
-        == 0
-    )
+    log, truth = _simulate_drifting(tmp_path, "random:105")
     fht, odo, mp = tmp_path / "fht.txt", tmp_path / "odo.txt", tmp_path / "map.json"
     r = run("slam", str(log), "--trajectory", str(fht), "--map", str(mp), "--quiet")
     assert r.returncode == 0, r.stderr
@@ -290,21 +281,7 @@ def test_slam_unknown_method_is_a_usage_error(tmp_path):
 
 @pytest.mark.parametrize("method", ["ekf", "classical", "graph"])
 def test_slam_methods_through_the_command_line(tmp_path, method):
-    log, truth = tmp_path / "p.clf", tmp_path / "truth.txt"
-    main(
-        [
-            "simulate",
-            "random:107",
-            "--odometry",
-            "drifting",
-            "--laps",
-            "3",
-            "--log",
-            str(log),
-            "--truth",
-            str(truth),
-        ]
-    )
+    log, truth = _simulate_drifting(tmp_path, "random:107")
     traj, mp = tmp_path / "t.txt", tmp_path / "m.json"
     r = run(
         "slam", str(log), "--method", method, "--trajectory", str(traj), "--map", str(mp), "--quiet"

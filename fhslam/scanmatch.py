@@ -71,8 +71,14 @@ class LikelihoodGrid:
         img = np.full((shape[1], shape[0]), 255, np.uint8)
         c = np.floor((p - lo) / resolution).astype(int)
         img[c[:, 1], c[:, 0]] = 0
-        d = cv2.distanceTransform(img, cv2.DIST_L2, cv2.DIST_MASK_PRECISE) * resolution
-        return cls(np.exp(-0.5 * (d / sigma) ** 2).astype(np.float32), lo, float(resolution))
+        # The exact transform's distance (in cells) is the square root of an integer, but
+        # OpenCV's float32 result varies in its last bit from run to run (seen in 1 of 2
+        # processes on the same input): round the squares back to those integers, so the
+        # grid depends on the points alone.
+        d = cv2.distanceTransform(img, cv2.DIST_L2, cv2.DIST_MASK_PRECISE)
+        d2 = np.rint(np.square(d, dtype=np.float64))
+        values = np.exp(-0.5 * d2 * (resolution / sigma) ** 2).astype(np.float32)
+        return cls(values, lo, float(resolution))
 
     def score(self, points: ArrayLike, pose: ArrayLike) -> float:
         """Mean likelihood of ``points`` placed at ``pose`` (points off the grid score 0)."""

@@ -86,3 +86,19 @@ def test_grid_score_and_voxel_downsample():
     cells = np.floor(v / 0.1).astype(int)
     assert len(np.unique(cells, axis=0)) == len(v)  # one point per cell
     assert len(np.unique(np.floor(room / 0.1).astype(int), axis=0)) == len(v)  # every cell
+
+
+def test_likelihood_grid_is_a_function_of_exact_squared_distances():
+    """OpenCV's float32 distances vary in the last bit between processes; the grid must not:
+    it equals exp(-d²/2σ²) of the exact integer squared cell distances (scipy's EDT)."""
+    from scipy.ndimage import distance_transform_edt
+
+    pts = np.random.default_rng(3).uniform(0, 4, (300, 2))
+    res, sigma = 0.05, 0.1
+    grid = LikelihoodGrid.build(pts, res, sigma, margin=0.5)
+    occupied = np.ones(grid.values.shape, bool)
+    c = np.floor((pts - grid.origin) / res).astype(int)
+    occupied[c[:, 1], c[:, 0]] = False
+    d2 = np.rint(distance_transform_edt(occupied) ** 2)
+    want = np.exp(-0.5 * d2 * (res / sigma) ** 2).astype(np.float32)
+    np.testing.assert_array_equal(grid.values, want)

@@ -1,0 +1,59 @@
+"""Golden numbers: trajectories, maps, extracted lines and figures pinned across refactors.
+
+``tests/golden/golden.npz`` was recorded by ``tests/golden/make_golden.py`` before the
+issue-9 move of the house (commit message says which). Every case is recomputed here through
+the package's calls and compared:
+
+- on a machine whose floating-point primitives give the recording's bits (the *arithmetic
+  fingerprint* of ``make_golden.py`` matches), every number must come out **bit for bit**;
+- on any other machine (another CPU's SIMD or BLAS kernels), the cases of the paper's
+  procedure and the EKF must still agree within 1e-6 (metres, radians): last-bit
+  differences measured under another OpenBLAS kernel set stay below 1e-9 there. The pose-graph
+  method (``graph``) is not compared then: its correlative search picks among near-equal
+  scores, so last-bit noise moves it by centimetres (issue 10 makes it robust).
+"""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+sys.path.insert(0, str(Path(__file__).resolve().parent / "golden"))
+import make_golden
+from conftest import data_dir
+
+RECORDED = np.load(make_golden.GOLDEN)
+CASES = sorted(k for k in RECORDED.files if k != "fingerprint")
+CROSS_MACHINE_TOL = 1e-6
+
+
+@pytest.fixture(scope="module")
+def same_arithmetic() -> bool:
+    return str(RECORDED["fingerprint"]) == make_golden.arithmetic_fingerprint()
+
+
+@pytest.fixture(scope="module")
+def computed() -> dict[str, np.ndarray]:
+    return make_golden.cases(make_golden.OldAPI(), data_dir())
+
+
+@pytest.mark.parametrize("case", CASES)
+def test_golden_case(case, computed, same_arithmetic):
+    want = RECORDED[case]
+    if case.startswith("real/") and case not in computed:
+        pytest.skip("no real laser logs: set FHSLAM_DATA or place them in ../shared/data")
+    if not same_arithmetic and "/graph/" in case:
+        pytest.skip("graph results are bit-stable only under the recording's arithmetic")
+    got = computed[case]
+    assert got.shape == want.shape, f"{case}: shape {got.shape}, recorded {want.shape}"
+    tol = 0.0 if same_arithmetic else CROSS_MACHINE_TOL
+    diff = make_golden.difference(case, got, want)
+    assert diff <= tol, f"{case}: largest difference {diff:.3g} > {tol:g}"
+
+
+def test_golden_cases_cover_every_method():
+    methods = {k.split("/")[2] for k in CASES if k.startswith("slam/paper/")}
+    assert methods == {"fht", "graph", "classical", "ekf", "odometry"}

@@ -26,7 +26,7 @@ import make_golden
 from conftest import data_dir
 
 RECORDED = np.load(make_golden.GOLDEN)
-CASES = sorted(k for k in RECORDED.files if k != "fingerprint")
+CASES = sorted(k for k in RECORDED.files if k not in ("fingerprint", "matplotlib"))
 CROSS_MACHINE_TOL = 1e-6
 
 
@@ -52,6 +52,34 @@ def test_golden_case(case, computed, same_arithmetic):
     tol = 0.0 if same_arithmetic else CROSS_MACHINE_TOL
     diff = make_golden.difference(case, got, want)
     assert diff <= tol, f"{case}: largest difference {diff:.3g} > {tol:g}"
+
+
+FIGURES = Path(__file__).resolve().parents[1] / "figures"
+
+
+def test_reproduce_rewrites_the_committed_figures(tmp_path, same_arithmetic):
+    """``fhslam reproduce`` gives the committed PNGs: byte for byte under the recording's
+    arithmetic and Matplotlib; with other arithmetic (same Matplotlib) at most 0.1 % of the
+    pixels may differ (a trajectory moved by 1e-13 m can tip an antialiased edge)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    from matplotlib.image import imread
+
+    from fhslam import figures
+
+    if matplotlib.__version__ != str(RECORDED["matplotlib"]):
+        pytest.skip(f"figures were recorded with Matplotlib {RECORDED['matplotlib']}")
+    paths = figures.reproduce(tmp_path)
+    assert sorted(p.name for p in paths) == sorted(p.name for p in FIGURES.glob("*.png"))
+    for p in paths:
+        ref = FIGURES / p.name
+        if same_arithmetic:
+            assert p.read_bytes() == ref.read_bytes(), f"{p.name} differs from figures/"
+        else:
+            a, b = imread(p), imread(ref)
+            assert a.shape == b.shape, p.name
+            assert np.mean(np.any(a != b, axis=-1)) <= 1e-3, p.name
 
 
 def test_golden_cases_cover_every_method():

@@ -167,7 +167,14 @@ def main() -> int:
             print(f"{k:45s} {v.shape!s:>12} max |diff| {d:.3g}")
         print(f"worst {worst:.3g}")
         return 0
-    np.savez_compressed(GOLDEN, fingerprint=np.array(arithmetic_fingerprint()), **got)
+    import matplotlib
+
+    np.savez_compressed(
+        GOLDEN,
+        fingerprint=np.array(arithmetic_fingerprint()),
+        matplotlib=np.array(matplotlib.__version__),
+        **got,
+    )
     print(f"wrote {len(got)} cases to {GOLDEN}")
     return 0
 

@@ -26,9 +26,10 @@ from fhslam.baselines import (
     hough_opencv_raster,
     split_and_merge,
 )
-from fhslam.extraction import extract_lines, scan_to_points
+from fhslam.extraction import extract_lines
 from fhslam.lines import Line
 from fhslam.metrics import detection_scores, true_lines
+from fhslam.scan import scan_to_points
 from fhslam.sim import load_world, simulate
 
 HELD_OUT_WORLDS = ("random:101", "random:102", "random:103", "random:104")

@@ -33,8 +33,9 @@ def _simulate(args: argparse.Namespace) -> None:
 def _info(args: argparse.Namespace) -> None:
     import numpy as np
 
-    from fhslam.extraction import extract_lines, scan_to_points
+    from fhslam.extraction import extract_lines
     from fhslam.io import read_carmen
+    from fhslam.scan import scan_to_points
 
     log = read_carmen(args.log)
     step = np.hypot(*np.diff(log.odometry[:, :2], axis=0).T).sum()

@@ -23,12 +23,12 @@ from fhslam.extraction import (
     cluster_scan,
     densify,
     extract_lines,
-    scan_to_points,
 )
 from fhslam.geometry import transform_points
 from fhslam.io import Log
 from fhslam.lines import Line, line_from_points
 from fhslam.matching import MatchParams, Similarity, merge, similarity
+from fhslam.scan import scan_to_points
 from fhslam.sim import OdometryNoise, World, paper_world, simulate
 from fhslam.slam import SlamResult, run_slam
 

@@ -145,6 +145,31 @@ def signed_distance(points: ArrayLike, rho: float, theta: float) -> NDArray[np.f
     return p[..., 0] * np.cos(theta) + p[..., 1] * np.sin(theta) - rho
 
 
+def observation(
+    rho: ArrayLike, theta: ArrayLike, x: ArrayLike, y: ArrayLike
+) -> tuple[NDArray[np.int64], NDArray[np.float64]]:
+    """The paper's observation direction ``dir`` and distance ``d`` of lines seen from (x, y).
+
+    ``dir = sign(rho - x cos(theta) - y sin(theta))`` (paper, "Match of feature lines",
+    Fig. 6): +1 when the robot is on the origin's side of the line, -1 beyond it, 0 on it;
+    ``d`` is the absolute value of the same expression, the robot's distance to the line.
+
+    Parameters
+    ----------
+    rho, theta : float or array-like, shape (K,)
+        Lines in Hessian normal form.
+    x, y : float or array-like
+        The robot's position, broadcast against the lines.
+
+    Returns
+    -------
+    dir : ndarray of int
+    d : ndarray of float
+    """
+    s = np.asarray(rho) - np.asarray(x) * np.cos(theta) - np.asarray(y) * np.sin(theta)
+    return np.sign(s).astype(np.int64), np.abs(s)
+
+
 def project_onto_line(points: ArrayLike, rho: float, theta: float) -> NDArray[np.float64]:
     """Orthogonal projection of points (N, 2) onto the line ``(rho, theta)``."""
     p = np.asarray(points, dtype=float)
@@ -152,15 +177,124 @@ def project_onto_line(points: ArrayLike, rho: float, theta: float) -> NDArray[np
     return p - signed_distance(p, rho, theta)[..., None] * n
 
 
+def position_on_line(points: ArrayLike, theta: ArrayLike) -> NDArray[np.float64]:
+    """Coordinate of points (..., 2) along lines of normal angle ``theta``: their dot product
+    with the direction ``u = (-sin(theta), cos(theta))`` (``u`` is the normal turned by +90°)."""
+    p = np.asarray(points, dtype=float)
+    return -p[..., 0] * np.sin(theta) + p[..., 1] * np.cos(theta)
+
+
+def point_on_line(rho: ArrayLike, theta: ArrayLike, t: ArrayLike) -> NDArray[np.float64]:
+    """The point at coordinate ``t`` along the line ``(rho, theta)``: ``rho n + t u`` with
+    ``n = (cos(theta), sin(theta))`` and ``u = (-sin(theta), cos(theta))``; shape (..., 2)."""
+    c, s = np.cos(theta), np.sin(theta)
+    return np.stack(np.broadcast_arrays(rho * c - t * s, rho * s + t * c), axis=-1)
+
+
+def tls_normal_angle(sxx: float, syy: float, sxy: float) -> float:
+    """Normal angle of the total-least-squares line through points with centred second
+    moments ``sxx = Σ(x - x̄)²``, ``syy``, ``sxy`` (any weights): the line's direction is the
+    principal axis ``0.5 atan2(2 sxy, sxx - syy)``, the normal is 90° further.
+
+    Plain scalar arithmetic, so :mod:`fhslam.extraction` compiles this very function into its
+    kernels (numba) and every least-squares line in the package is fitted by one formula.
+    """
+    return 0.5 * np.arctan2(2.0 * sxy, sxx - syy) + 0.5 * np.pi
+
+
 def point_segment_distance(points: ArrayLike, a: ArrayLike, b: ArrayLike) -> NDArray[np.float64]:
-    """Euclidean distance of points (N, 2) to the segment from ``a`` to ``b``."""
+    """Euclidean distance of points to segments from ``a`` to ``b``; all (..., 2), broadcast.
+
+    A degenerate segment (``a == b``) is the point ``a``.
+    """
     p = np.asarray(points, dtype=float)
     a = np.asarray(a, dtype=float)
-    b = np.asarray(b, dtype=float)
-    ab = b - a
-    denom = float(ab @ ab)
-    t = np.zeros(len(p)) if denom == 0.0 else np.clip((p - a) @ ab / denom, 0.0, 1.0)
-    return np.hypot(*(p - (a + t[:, None] * ab)).T)
+    ab = np.asarray(b, dtype=float) - a
+    denom = np.maximum((ab * ab).sum(-1), 1e-300)
+    t = np.clip(((p - a) * ab).sum(-1) / denom, 0.0, 1.0)
+    return np.linalg.norm(p - (a + t[..., None] * ab), axis=-1)
+
+
+_CHUNK = 1 << 20  # elements of a (points x segments) block
+
+
+def distance_to_segments(points: ArrayLike, segments: ArrayLike) -> NDArray[np.float64]:
+    """Distance from each point to the nearest of the segments, metres.
+
+    Broadcasts points against segments in blocks of about a million pairs.
+
+    Parameters
+    ----------
+    points : array-like, shape (P, 2)
+    segments : array-like, shape (M, 4), M >= 1
+        Rows ``[x1, y1, x2, y2]``.
+
+    Returns
+    -------
+    ndarray, shape (P,)
+    """
+    p = np.asarray(points, dtype=float).reshape(-1, 2)
+    s = np.asarray(segments, dtype=float).reshape(-1, 4)
+    if len(s) == 0:
+        raise ValueError("distance_to_segments needs at least one segment")
+    out = np.empty(len(p))
+    rows = max(1, _CHUNK // len(s))
+    for lo in range(0, len(p), rows):
+        d = point_segment_distance(p[lo : lo + rows, None, :], s[:, :2], s[:, 2:])
+        out[lo : lo + rows] = d.min(axis=1)
+    return out
+
+
+def segment_distances(s: ArrayLike, t: ArrayLike) -> NDArray[np.float64]:
+    """Shortest distance between every segment of ``s`` (N, 4) and of ``t`` (M, 4): (N, M).
+
+    Zero where two segments cross; otherwise the smallest endpoint-to-segment distance.
+    """
+    s = np.asarray(s, dtype=float).reshape(-1, 4)
+    t = np.asarray(t, dtype=float).reshape(-1, 4)
+    a, b = s[:, None, :2], s[:, None, 2:]
+    c, d = t[None, :, :2], t[None, :, 2:]
+    dist = np.minimum.reduce(
+        [point_segment_distance(a, c, d), point_segment_distance(b, c, d),
+         point_segment_distance(c, a, b), point_segment_distance(d, a, b)]
+    )  # fmt: skip
+
+    def cross(u: NDArray, v: NDArray) -> NDArray:
+        return u[..., 0] * v[..., 1] - u[..., 1] * v[..., 0]
+
+    crossing = (cross(b - a, c - a) * cross(b - a, d - a) < 0) & (
+        cross(d - c, a - c) * cross(d - c, b - c) < 0
+    )
+    return np.where(crossing, 0.0, dist)
+
+
+def ray_segment_intersection(
+    origin: ArrayLike, direction: ArrayLike, a: ArrayLike, b: ArrayLike
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """Where rays ``origin + t direction`` meet the lines through segments ``a``-``b``.
+
+    Solves ``o + t d = a + s (b - a)`` with 2D cross products: ``t = (a - o) × (b - a) /
+    d × (b - a)``, ``s = (a - o) × d / d × (b - a)``. The ray hits the segment when ``t > 0``
+    and ``0 <= s <= 1``; a ray parallel to the segment gives ``inf`` or ``nan`` (no warning).
+
+    Parameters
+    ----------
+    origin, direction, a, b : array-like, shape (..., 2)
+        Broadcast against each other (e.g. one origin, beams (B, 1, 2), walls (M, 2)).
+
+    Returns
+    -------
+    t, s : ndarray
+        Range along the ray (in units of ``|direction|``) and position along the segment.
+    """
+    o, d = np.asarray(origin, dtype=float), np.asarray(direction, dtype=float)
+    a = np.asarray(a, dtype=float)
+    p, e = a - o, np.asarray(b, dtype=float) - a
+    denom = d[..., 0] * e[..., 1] - d[..., 1] * e[..., 0]
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+        t = (p[..., 0] * e[..., 1] - p[..., 1] * e[..., 0]) / denom
+        s = (p[..., 0] * d[..., 1] - p[..., 1] * d[..., 0]) / denom
+    return t, s
 
 
 def angle_difference_lines(theta_a: ArrayLike, theta_b: ArrayLike) -> NDArray | float:

@@ -44,12 +44,12 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from tqdm.auto import tqdm
 
-from fhslam.extraction import scan_to_points
 from fhslam.geometry import as_pose, compose, relative, signed_distance, transform_points
 from fhslam.io.log import scan_of
 from fhslam.lines import Line, transform_lines
 from fhslam.matching import match_lines, merge
 from fhslam.posegraph import PoseGraph
+from fhslam.scan import scan_to_points
 from fhslam.scanmatch import match_clouds, voxel_downsample
 from fhslam.slam import FastHoughSLAM, SlamParams, SlamResult, StepResult
 

@@ -33,9 +33,9 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from fhslam.extraction import scan_to_points
 from fhslam.geometry import inverse, line_through, relative, transform_points, wrap_angle
 from fhslam.lines import Line
+from fhslam.scan import scan_to_points
 
 
 @dataclass(frozen=True)

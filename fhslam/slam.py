@@ -25,11 +25,12 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from tqdm.auto import tqdm
 
-from fhslam.extraction import ExtractionParams, extract_lines, scan_to_points
+from fhslam.extraction import ExtractionParams, extract_lines
 from fhslam.geometry import as_pose, compose, inverse, relative, signed_distance, wrap_angle
 from fhslam.io.log import scan_of
 from fhslam.lines import Line, transform_lines
 from fhslam.matching import MatchParams, match_lines, merge
+from fhslam.scan import scan_to_points
 
 
 @dataclass(frozen=True)

@@ -16,11 +16,11 @@ from fhslam.extraction import (
     extract_lines,
     extract_lines_from_scan,
     restricted_hough,
-    scan_to_points,
     slope_histogram,
 )
 from fhslam.geometry import inverse, line_through, transform_points
 from fhslam.metrics import line_difference
+from fhslam.scan import Scan, scan_to_points
 
 
 def true_room_lines(pose):
@@ -126,7 +126,7 @@ def test_endpoints_lie_on_the_wall_ends():
 def test_scan_entry_point_maps_inliers_to_beams():
     r, a = cast(ROOM, (2.0, 1.5, 0.3))
     r[10:20] = np.nan
-    lines, beams = extract_lines_from_scan(r, a, max_range=8.0)
+    lines, beams = extract_lines_from_scan(Scan(r, a, max_range=8.0))
     assert len(lines) == 3
     assert not np.isin(np.arange(10, 20), np.concatenate([beams[ln.inliers] for ln in lines])).any()
 

@@ -128,8 +128,8 @@ def test_fr079_laser_offset_from_tf_static(real_data):
 def test_an_interlaced_laser_gets_per_scan_bearing_offsets(tmp_path):
     """Scans starting a quarter beam apart (181, 180, 180, 180 beams) read into one Log
     whose ``scan(k)`` bearings put every point back on the wall x = 2 m."""
-    from fhslam.extraction import scan_to_points
     from fhslam.io import write_carmen
+    from fhslam.scan import scan_to_points
 
     log = read_bag(write_bag(tmp_path / "i.bag", scans=6, interlaced=True))
     inc = np.pi / 180

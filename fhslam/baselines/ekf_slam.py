@@ -26,10 +26,11 @@ from filterpy.kalman import ExtendedKalmanFilter
 from numpy.typing import ArrayLike, NDArray
 from tqdm.auto import tqdm
 
-from fhslam.extraction import ExtractionParams, extract_lines, scan_to_points
+from fhslam.extraction import ExtractionParams, extract_lines
 from fhslam.geometry import as_pose, compose, relative, wrap_angle
 from fhslam.io.log import scan_of
 from fhslam.lines import Line
+from fhslam.scan import scan_to_points
 
 CHI2_2DOF_99 = 9.2103
 """99 % quantile of the χ² distribution with 2 degrees of freedom."""

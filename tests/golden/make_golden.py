@@ -126,7 +126,8 @@ class OldAPI:
 
         from fhslam import figures
         from fhslam.data import load_log
-        from fhslam.extraction import extract_lines, scan_to_points
+        from fhslam.extraction import extract_lines
+        from fhslam.scan import scan_to_points
         from fhslam.sim import OdometryNoise, degrade, load_world, simulate
         from fhslam.slam import run_slam
 

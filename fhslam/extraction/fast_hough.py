@@ -13,13 +13,13 @@ simulation's step list) extracts wall lines from one laser scan in three moves:
    refinement on the inliers, and then the next line ("sub-maximum") on the points that are
    left, until the support falls under a threshold.
 
-Every step works on all clusters at once: points carry a cluster label, and each round of
-"take the best line, remove its points" is a few NumPy calls for the whole scan rather than a
-Python loop over clusters. A step can be shown on a single cluster by giving all its points
-label 0.
+Each step is a public function taking the scan's points and cluster labels, so a notebook
+can show it on its own (a single cluster: give all its points label 0); each calls the same
+compiled per-cluster kernel (:mod:`fhslam.extraction._kernels`) that :func:`extract_lines`,
+the whole of Loop 1, runs on every cluster of a scan.
 
-The public entry point is :func:`extract_lines` (points in scan order, any frame) or
-:func:`extract_lines_from_scan` (ranges and bearings).
+The entry point is :func:`extract_lines` (points in scan order, any frame) or
+:func:`extract_lines_from_scan` (a :class:`fhslam.scan.Scan`).
 """
 
 from __future__ import annotations
@@ -29,11 +29,12 @@ from dataclasses import dataclass
 from typing import Literal
 
 import numpy as np
-from numba import njit
 from numpy.typing import ArrayLike, NDArray
 
-from fhslam.geometry import as_points, as_pose, polar_to_points
+from fhslam.extraction import _kernels as kernels
+from fhslam.geometry import as_points, as_pose, observation
 from fhslam.lines import Line
+from fhslam.scan import Scan
 
 
 @dataclass(frozen=True)
@@ -135,393 +136,6 @@ class ExtractionParams:
             )
 
 
-# --------------------------------------------------------------------------- scan → points
-
-
-def scan_to_points(
-    ranges: ArrayLike,
-    angles: ArrayLike,
-    max_range: float | None = None,
-    min_range: float = 0.0,
-) -> tuple[NDArray[np.float64], NDArray[np.intp]]:
-    """Turn one scan into points in the laser frame, dropping invalid beams.
-
-    A beam is invalid when its range is NaN, infinite, ``<= min_range`` or ``>= max_range``
-    ("no return"); it is dropped, never turned into a point.
-
-    Parameters
-    ----------
-    ranges, angles : array-like, shape (B,)
-        Ranges (metres) and bearings (radians) of the beams, in scan order.
-    max_range : float, optional
-        The sensor's maximum range; readings at or beyond it mean "no return".
-
-    Returns
-    -------
-    points : ndarray, shape (N, 2)
-    beams : ndarray of int, shape (N,)
-        Index of the beam each point came from.
-    """
-    r = np.asarray(ranges, dtype=float)
-    a = np.asarray(angles, dtype=float)
-    if r.ndim != 1 or r.shape != a.shape:
-        raise ValueError(
-            f"ranges and angles must be 1-D arrays of equal length, got {r.shape} and {a.shape}"
-        )
-    if not np.all(np.isfinite(a)):
-        raise ValueError("angles contain NaN or inf")
-    valid = np.isfinite(r) & (r > min_range)
-    if max_range is not None:
-        valid &= r < max_range
-    beams = np.flatnonzero(valid)
-    return polar_to_points(r[beams], a[beams]), beams
-
-
-# --------------------------------------------------------------------------- kernels
-#
-# Each step of Loop 1 is one small compiled kernel working on ONE cluster, written as the
-# paper describes it (plain loops). The public functions below validate their input and call
-# the same kernels per cluster, so what a notebook shows is exactly what the pipeline runs.
-# NumPy vectorisation of this loop costs 5-15 µs per array call on arrays this small and
-# ~1.4 ms per scan; compiled, the whole scan takes tens of µs (see `fhslam bench`).
-
-_JIT = {"cache": True, "nogil": True, "fastmath": False}
-
-
-@njit(**_JIT)
-def _cluster_kernel(p, gap):
-    n = p.shape[0]
-    labels = np.zeros(n, np.int64)
-    g2 = gap * gap
-    for i in range(1, n):
-        dx = p[i, 0] - p[i - 1, 0]
-        dy = p[i, 1] - p[i - 1, 1]
-        labels[i] = labels[i - 1] + (1 if dx * dx + dy * dy > g2 else 0)
-    return labels
-
-
-@njit(**_JIT)
-def _lone_kernel(p, gap):
-    n = p.shape[0]
-    lone = np.zeros(n, np.bool_)
-    for i in range(1, n - 1):
-        d_prev = np.hypot(p[i, 0] - p[i - 1, 0], p[i, 1] - p[i - 1, 1])
-        d_next = np.hypot(p[i + 1, 0] - p[i, 0], p[i + 1, 1] - p[i, 1])
-        d_skip = np.hypot(p[i + 1, 0] - p[i - 1, 0], p[i + 1, 1] - p[i - 1, 1])
-        lone[i] = d_prev > gap and d_next > gap and d_skip <= 2 * gap
-    return lone
-
-
-@njit(**_JIT)
-def _densify_kernel(p, step):
-    """Insert points every <= step between consecutive points (one cluster)."""
-    n = p.shape[0]
-    extra = np.zeros(n, np.int64)
-    total = n
-    if step > 0:
-        for i in range(n - 1):
-            d = np.hypot(p[i + 1, 0] - p[i, 0], p[i + 1, 1] - p[i, 1])
-            extra[i] = max(int(np.ceil(d / step)) - 1, 0)
-            total += extra[i]
-    out = np.empty((total, 2))
-    src = np.empty(total, np.int64)
-    k = 0
-    for i in range(n):
-        out[k] = p[i]
-        src[k] = i
-        k += 1
-        for j in range(1, extra[i] + 1):
-            f = j / (extra[i] + 1)
-            out[k, 0] = p[i, 0] + f * (p[i + 1, 0] - p[i, 0])
-            out[k, 1] = p[i, 1] + f * (p[i + 1, 1] - p[i, 1])
-            src[k] = -1
-            k += 1
-    return out, src
-
-
-@njit(**_JIT)
-def _slope_histogram_kernel(p, u, n_bins, min_pair_dist, all_pairs):
-    """Votes of the direction angle in [0, pi) of the line through point pairs (one cluster)."""
-    m = p.shape[0]
-    hist = np.zeros(n_bins, np.int64)
-    d2min = min_pair_dist * min_pair_dist
-    n_pairs = m * (m - 1) // 2 if all_pairs else u.shape[0]
-    a, b = 0, 0
-    for k in range(n_pairs):
-        if all_pairs:
-            b += 1
-            if b >= m:
-                a += 1
-                b = a + 1
-        else:
-            a = int(u[k, 0] * m)
-            b = int(u[k, 1] * m)
-        dx = p[b, 0] - p[a, 0]
-        dy = p[b, 1] - p[a, 1]
-        if dx * dx + dy * dy < d2min:
-            continue
-        phi = np.arctan2(dy, dx)
-        if phi < 0:
-            phi += np.pi
-        k_bin = min(int(phi * n_bins / np.pi), n_bins - 1)
-        hist[k_bin] += 1
-    return hist
-
-
-@njit(**_JIT)
-def _dominant_kernel(hist):
-    """Peak of the circularly [1, 2, 1]/4-smoothed histogram: (direction, support)."""
-    n = hist.shape[0]
-    best, k_best = -1.0, 0
-    for k in range(n):
-        s = 0.5 * hist[k] + 0.25 * (hist[k - 1] + hist[(k + 1) % n])
-        if s > best:
-            best, k_best = s, k
-    return (k_best + 0.5) * np.pi / n, best
-
-
-@njit(**_JIT)
-def _window_hough_kernel(p, phi, half, dtheta, rho_step):
-    """rho-theta accumulator restricted to normal angles phi + pi/2 + [-half, half]*dtheta.
-
-    rho is measured from the centroid of ``p``. Returns the peak (rho in the points' frame,
-    theta), its votes, the accumulator (W, R), its thetas and the local rho of column 0.
-    """
-    m = p.shape[0]
-    cx, cy = 0.0, 0.0
-    for i in range(m):
-        cx += p[i, 0]
-        cy += p[i, 1]
-    cx /= m
-    cy /= m
-    n_w = 2 * half + 1
-    thetas = np.empty(n_w)
-    for w in range(n_w):
-        thetas[w] = phi + 0.5 * np.pi + (w - half) * dtheta
-    idx = np.empty((n_w, m), np.int64)
-    lo, hi = 1 << 62, -(1 << 62)
-    for w in range(n_w):
-        c, s = np.cos(thetas[w]), np.sin(thetas[w])
-        for i in range(m):
-            r = int(np.floor(((p[i, 0] - cx) * c + (p[i, 1] - cy) * s) / rho_step + 0.5))
-            idx[w, i] = r
-            lo = min(lo, r)
-            hi = max(hi, r)
-    acc = np.zeros((n_w, hi - lo + 1), np.int64)
-    best, w_best, r_best = -1, 0, 0
-    for w in range(n_w):
-        for i in range(m):
-            r = idx[w, i] - lo
-            acc[w, r] += 1
-            if acc[w, r] > best or (acc[w, r] == best and (w, r) < (w_best, r_best)):
-                best, w_best, r_best = acc[w, r], w, r
-    theta = thetas[w_best]
-    rho = (r_best + lo) * rho_step + cx * np.cos(theta) + cy * np.sin(theta)
-    return rho, theta, best, acc, thetas, lo * rho_step, cx, cy
-
-
-@njit(**_JIT)
-def _tls_kernel(p, mask, theta_prev):
-    """Total least squares over p[mask]: (rho, theta, count); theta kept near theta_prev."""
-    n = 0
-    mx, my = 0.0, 0.0
-    for i in range(p.shape[0]):
-        if mask[i]:
-            n += 1
-            mx += p[i, 0]
-            my += p[i, 1]
-    if n < 2:
-        return np.nan, theta_prev, n
-    mx /= n
-    my /= n
-    cxx, cyy, cxy = 0.0, 0.0, 0.0
-    for i in range(p.shape[0]):
-        if mask[i]:
-            dx, dy = p[i, 0] - mx, p[i, 1] - my
-            cxx += dx * dx
-            cyy += dy * dy
-            cxy += dx * dy
-    if cxx + cyy == 0.0:
-        return np.nan, theta_prev, n
-    theta = 0.5 * np.arctan2(2.0 * cxy, cxx - cyy) + 0.5 * np.pi
-    if np.cos(theta - theta_prev) < 0:
-        theta += np.pi
-    return mx * np.cos(theta) + my * np.sin(theta), theta, n
-
-
-@njit(**_JIT)
-def _inliers(p, rho, theta, tol, out):
-    c, s = np.cos(theta), np.sin(theta)
-    n = 0
-    for i in range(p.shape[0]):
-        out[i] = abs(p[i, 0] * c + p[i, 1] * s - rho) <= tol
-        n += out[i]
-    return n
-
-
-@njit(**_JIT)
-def _extract_kernel(
-    p,
-    u,
-    gap,
-    dense_step,
-    n_bins,
-    min_pair_dist,
-    all_pairs,
-    half,
-    dtheta,
-    rho_step,
-    tol,
-    refine_iterations,
-    min_points,
-    min_length,
-    max_rounds,
-    max_peaks,
-):
-    """The whole of Loop 1 for one scan.
-
-    Returns per segment ``(rho, theta, rms, sp_x, sp_y, ep_x, ep_y)`` in the paper's form and
-    its inlier indices (``flat[offsets[k]:offsets[k + 1]]``).
-    """
-    n = p.shape[0]
-    labels = _cluster_kernel(p, gap)
-    seg = np.empty((n // 2 + 1, 7))
-    offsets = np.zeros(n // 2 + 2, np.int64)
-    flat = np.empty(n, np.int64)
-    n_seg = 0
-    start = 0
-    while start < n:
-        stop = start
-        while stop < n and labels[stop] == labels[start]:
-            stop += 1
-        m = stop - start
-        if m >= min_points:
-            pts = p[start:stop]
-            votes, _src = _densify_kernel(pts, dense_step)
-            alive = np.ones(m, np.bool_)
-            valive = np.ones(votes.shape[0], np.bool_)
-            inl = np.zeros(m, np.bool_)
-            vinl = np.zeros(votes.shape[0], np.bool_)
-            n_alive = m
-            for _round in range(max_rounds):
-                vp = votes[valive]
-                if vp.shape[0] < 2:
-                    break
-                hist = _slope_histogram_kernel(vp, u, n_bins, min_pair_dist, all_pairs)
-                # The maximum of the histogram, else its sub-maxima: a slope voted by pairs
-                # across two walls may hold no line while the next peak does.
-                n_inl = 0
-                for _peak in range(max_peaks):
-                    phi, support = _dominant_kernel(hist)
-                    if support <= 0:
-                        break
-                    rho, theta = _window_hough_kernel(vp, phi, half, dtheta, rho_step)[:2]
-                    # Inliers among the remaining scan points, refined by least squares.
-                    for _it in range(refine_iterations + 1):
-                        _inliers(pts, rho, theta, tol, inl)
-                        inl &= alive
-                        if _it == refine_iterations:
-                            break
-                        r2, t2, k = _tls_kernel(pts, inl, theta)
-                        if k < 2 or np.isnan(r2):
-                            break
-                        rho, theta = r2, t2
-                    n_inl = 0
-                    for i in range(m):
-                        n_inl += inl[i]
-                    if n_inl >= min_points:
-                        break
-                    k_peak = int(phi * n_bins / np.pi)  # suppress this peak and its window
-                    w_bins = max(1, int(np.ceil(half * dtheta * n_bins / np.pi)))
-                    for b in range(k_peak - w_bins, k_peak + w_bins + 1):
-                        hist[b % n_bins] = 0
-                if n_inl < min_points:
-                    break  # support under the threshold at every peak: this cluster is done
-                # Split the line's inliers at gaps; keep long-enough runs as segments.
-                run_start = -1
-                last = -1
-                for i in range(m + 1):
-                    is_in = i < m and inl[i]
-                    cut = not is_in
-                    if is_in and last >= 0:
-                        dx = pts[i, 0] - pts[last, 0]
-                        dy = pts[i, 1] - pts[last, 1]
-                        cut = dx * dx + dy * dy > gap * gap
-                    if cut and run_start >= 0:
-                        n_seg = _emit(
-                            pts,
-                            inl,
-                            run_start,
-                            last,
-                            theta,
-                            start,
-                            min_points,
-                            min_length,
-                            seg,
-                            offsets,
-                            flat,
-                            n_seg,
-                        )
-                        run_start = -1
-                    if is_in:
-                        if run_start < 0:
-                            run_start = i
-                        last = i
-                for i in range(m):
-                    if inl[i]:
-                        alive[i] = False
-                        n_alive -= 1
-                _inliers(votes, rho, theta, tol, vinl)
-                valive &= ~vinl
-                if n_alive < min_points:
-                    break
-        start = stop
-    return seg[:n_seg], offsets[: n_seg + 1], flat[: offsets[n_seg]]
-
-
-@njit(**_JIT)
-def _emit(
-    pts, inl, first, last, theta_prev, base, min_points, min_length, seg, offsets, flat, n_seg
-):
-    """Fit the run inl[first..last] and append it as a segment if it is long enough."""
-    mask = np.zeros(pts.shape[0], np.bool_)
-    mask[first : last + 1] = inl[first : last + 1]
-    rho, theta, k = _tls_kernel(pts, mask, theta_prev)
-    if k < min_points or np.isnan(rho):
-        return n_seg
-    c, s = np.cos(theta), np.sin(theta)
-    t_lo, t_hi = np.inf, -np.inf
-    ss = 0.0
-    for i in range(first, last + 1):
-        if mask[i]:
-            t = -pts[i, 0] * s + pts[i, 1] * c
-            t_lo, t_hi = min(t_lo, t), max(t_hi, t)
-            r = pts[i, 0] * c + pts[i, 1] * s - rho
-            ss += r * r
-    if t_hi - t_lo < min_length:
-        return n_seg
-    t_first = -pts[first, 0] * s + pts[first, 1] * c
-    t_last = -pts[last, 0] * s + pts[last, 1] * c
-    if t_first > t_last:
-        t_lo, t_hi = t_hi, t_lo
-    if rho < 0:  # the paper's form: rho >= 0, theta in [0, 2 pi)
-        rho, theta, c, s, t_lo, t_hi = -rho, theta + np.pi, -c, -s, -t_lo, -t_hi
-    seg[n_seg, 0] = rho
-    seg[n_seg, 1] = theta % (2.0 * np.pi)
-    seg[n_seg, 2] = np.sqrt(ss / k)
-    seg[n_seg, 3] = rho * c - t_lo * s  # sp
-    seg[n_seg, 4] = rho * s + t_lo * c
-    seg[n_seg, 5] = rho * c - t_hi * s  # ep
-    seg[n_seg, 6] = rho * s + t_hi * c
-    o = offsets[n_seg]
-    for i in range(first, last + 1):
-        if mask[i]:
-            flat[o] = base + i
-            o += 1
-    offsets[n_seg + 1] = o
-    return n_seg + 1
-
-
 @functools.lru_cache(maxsize=16)
 def _pair_uniforms(seed: int, n_pairs: int) -> NDArray[np.float64]:
     """The seeded table of uniform numbers from which random point pairs are drawn."""
@@ -546,7 +160,7 @@ def lone_points(points: ArrayLike, gap: float) -> NDArray[np.bool_]:
     -------
     ndarray of bool, shape (N,)
     """
-    return _lone_kernel(np.ascontiguousarray(as_points(points)), float(gap))
+    return kernels.lone_kernel(np.ascontiguousarray(as_points(points)), float(gap))
 
 
 def cluster_scan(points: ArrayLike, gap: float) -> NDArray[np.intp]:
@@ -564,7 +178,7 @@ def cluster_scan(points: ArrayLike, gap: float) -> NDArray[np.intp]:
     labels : ndarray of int, shape (N,)
         Cluster label of each point, 0, 1, 2, ... in scan order.
     """
-    return _cluster_kernel(as_points(points), float(gap))
+    return kernels.cluster_kernel(as_points(points), float(gap))
 
 
 def densify(
@@ -595,7 +209,7 @@ def densify(
     lab = np.asarray(labels, dtype=np.intp)
     parts, labs, srcs = [], [], []
     for s, m in zip(*_segments(lab), strict=True):
-        d, src = _densify_kernel(p[s : s + m], float(step))
+        d, src = kernels.densify_kernel(p[s : s + m], float(step))
         parts.append(d)
         labs.append(np.full(len(d), lab[s]))
         srcs.append(np.where(src >= 0, src + s, -1))
@@ -654,7 +268,7 @@ def slope_histogram(
             else _pair_uniforms(params.seed, params.n_pairs)
         )
         out.append(
-            _slope_histogram_kernel(
+            kernels.slope_histogram_kernel(
                 p[s : s + m], u, n_bins, params.min_pair_dist, params.pairs == "all"
             )
         )
@@ -681,7 +295,7 @@ def dominant_angle(hist: ArrayLike) -> tuple[NDArray[np.float64], NDArray[np.flo
         Smoothed vote count at the peak; 0 for a cluster without any valid pair.
     """
     h = np.atleast_2d(np.asarray(hist, dtype=np.int64))
-    res = np.array([_dominant_kernel(row) for row in h]).reshape(-1, 2)
+    res = np.array([kernels.dominant_kernel(row) for row in h]).reshape(-1, 2)
     return res[:, 0], res[:, 1]
 
 
@@ -735,7 +349,7 @@ def restricted_hough(
     half = round(params.window_deg / params.theta_step_deg)
     rows, accs = [], []
     for c, (s, m) in enumerate(zip(*_segments(np.asarray(labels)), strict=True)):
-        rho, theta, votes, acc, thetas, rho0, cx, cy = _window_hough_kernel(
+        rho, theta, votes, acc, thetas, rho0, cx, cy = kernels.window_hough_kernel(
             p[s : s + m], phi[c], half, np.radians(params.theta_step_deg), params.rho_step
         )
         rows.append((rho, theta, votes, cx, cy))
@@ -791,11 +405,11 @@ def extract_lines(
         return []
     kept = None
     if params.drop_lone_points:
-        lone = _lone_kernel(p, params.cluster_gap)
+        lone = kernels.lone_kernel(p, params.cluster_gap)
         if lone.any():
             kept = np.flatnonzero(~lone)
             p = np.ascontiguousarray(p[kept])
-    seg, offsets, flat = _extract_kernel(
+    seg, offsets, flat = kernels.extract_kernel(
         p,
         _pair_uniforms(params.seed, params.n_pairs),
         params.cluster_gap,
@@ -818,7 +432,7 @@ def extract_lines(
     n_in = np.diff(offsets)
     length = np.hypot(seg[:, 5] - seg[:, 3], seg[:, 6] - seg[:, 4])
     if pose is not None:
-        side = seg[:, 0] - pose[0] * np.cos(seg[:, 1]) - pose[1] * np.sin(seg[:, 1])
+        side, dist = observation(seg[:, 0], seg[:, 1], pose[0], pose[1])
     lines = []
     for k, (rho, theta, rms, *_ends) in enumerate(seg.tolist()):
         lines.append(
@@ -829,8 +443,8 @@ def extract_lines(
                 length=float(length[k]),
                 sp=seg[k, 3:5],
                 ep=seg[k, 5:7],
-                dir=None if pose is None else int(np.sign(side[k])),
-                d=None if pose is None else float(abs(side[k])),
+                dir=None if pose is None else int(side[k]),
+                d=None if pose is None else float(dist[k]),
                 inliers=flat[offsets[k] : offsets[k + 1]],
                 rms=rms,
             )
@@ -839,18 +453,15 @@ def extract_lines(
 
 
 def extract_lines_from_scan(
-    ranges: ArrayLike,
-    angles: ArrayLike,
-    params: ExtractionParams | None = None,
-    max_range: float | None = None,
-    pose: ArrayLike | None = None,
+    scan: Scan, params: ExtractionParams | None = None, pose: ArrayLike | None = None
 ) -> tuple[list[Line], NDArray[np.intp]]:
-    """:func:`extract_lines` on a raw scan, in the laser frame.
+    """:func:`extract_lines` on a raw scan, in the laser frame (invalid beams dropped by
+    :meth:`fhslam.scan.Scan.points`).
 
     Returns the lines and the beam index of every point (``beams[line.inliers]`` are the
     beams supporting a line).
     """
-    pts, beams = scan_to_points(ranges, angles, max_range=max_range)
+    pts, beams = scan.points()
     return extract_lines(pts, params, pose=pose), beams
 
 
@@ -864,6 +475,5 @@ __all__ = [
     "extract_lines_from_scan",
     "lone_points",
     "restricted_hough",
-    "scan_to_points",
     "slope_histogram",
 ]

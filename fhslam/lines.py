@@ -19,7 +19,16 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from fhslam.geometry import as_pose, normalize_line, signed_distance, transform_points
+from fhslam.geometry import (
+    as_pose,
+    normalize_line,
+    observation,
+    point_on_line,
+    position_on_line,
+    signed_distance,
+    tls_normal_angle,
+    transform_points,
+)
 
 
 @dataclass(frozen=True, eq=False)
@@ -70,8 +79,8 @@ class Line:
     def observed_from(self, pose: ArrayLike) -> Line:
         """The same line with ``dir`` and ``d`` computed for a robot at ``pose``."""
         p = as_pose(pose)
-        s = float(self.rho - p[0] * np.cos(self.theta) - p[1] * np.sin(self.theta))
-        return replace(self, dir=int(np.sign(s)), d=abs(s))
+        side, d = observation(self.rho, self.theta, p[0], p[1])
+        return replace(self, dir=int(side), d=float(d))
 
     def transformed(self, pose: ArrayLike) -> Line:
         """The line mapped by the rigid motion ``pose`` (e.g. from robot to world frame).
@@ -114,9 +123,7 @@ def fit_line(points: ArrayLike) -> tuple[float, float, float]:
     sxx, syy, sxy = (q[:, 0] ** 2).sum(), (q[:, 1] ** 2).sum(), (q[:, 0] * q[:, 1]).sum()
     if sxx + syy == 0.0:
         raise ValueError("fit_line got identical points: the line direction is undefined")
-    # Principal direction angle; the normal is perpendicular to it.
-    phi = 0.5 * np.arctan2(2.0 * sxy, sxx - syy)
-    theta = phi + np.pi / 2
+    theta = tls_normal_angle(sxx, syy, sxy)
     rho = c[0] * np.cos(theta) + c[1] * np.sin(theta)
     r, t = normalize_line(rho, theta)
     rms = float(np.sqrt(np.mean(signed_distance(p, float(r), float(t)) ** 2)))
@@ -150,13 +157,10 @@ def line_from_points(
     else:
         rho, theta = (float(v) for v in normalize_line(*rho_theta))
         rms = float(np.sqrt(np.mean(signed_distance(q, rho, theta) ** 2))) if len(q) else 0.0
-    n = np.array([np.cos(theta), np.sin(theta)])
-    u = np.array([-n[1], n[0]])  # direction along the line
-    t = q @ u
-    base = rho * n
+    t = position_on_line(q, theta)
     # Extreme projections, oriented so that sp lies on the side of the first point in scan order.
     lo, hi = (t.min(), t.max()) if t[0] <= t[-1] else (t.max(), t.min())
-    sp, ep = base + lo * u, base + hi * u
+    sp, ep = point_on_line(rho, theta, np.array([lo, hi]))
     line = Line(
         rho=rho,
         theta=theta,

@@ -23,7 +23,14 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from fhslam.geometry import as_pose
+from fhslam.geometry import (
+    as_pose,
+    normalize_line,
+    observation,
+    point_on_line,
+    position_on_line,
+    tls_normal_angle,
+)
 from fhslam.lines import Line
 
 
@@ -90,6 +97,7 @@ class _Segs:
     """Lines as arrays: normals (K, 2), rho (K,), endpoints (K, 2) x2."""
 
     n: NDArray[np.float64]
+    theta: NDArray[np.float64]
     rho: NDArray[np.float64]
     sp: NDArray[np.float64]
     ep: NDArray[np.float64]
@@ -99,6 +107,7 @@ class _Segs:
         theta = np.array([ln.theta for ln in lines], dtype=float)
         return cls(
             n=np.column_stack([np.cos(theta), np.sin(theta)]).reshape(-1, 2),
+            theta=theta,
             rho=np.array([ln.rho for ln in lines], dtype=float),
             sp=np.array([ln.sp for ln in lines], dtype=float).reshape(-1, 2),
             ep=np.array([ln.ep for ln in lines], dtype=float).reshape(-1, 2),
@@ -107,7 +116,7 @@ class _Segs:
 
 def _directions(s: _Segs, pose: NDArray[np.float64] | None, lines: Sequence[Line]) -> NDArray:
     if pose is not None:
-        return np.sign(s.rho - s.n @ pose[:2]).astype(int)
+        return observation(s.rho, s.theta, pose[0], pose[1])[0]
     if any(ln.dir is None for ln in lines):
         raise ValueError("condition (a) needs each line's dir: pass pose=, or lines with dir")
     return np.array([ln.dir for ln in lines], dtype=int)
@@ -228,21 +237,16 @@ def merge(ref: Line, new: Line) -> Line:
     w = w1 + w2
     mean = (w1 * m1 + w2 * m2) / w
     scatter = s1 + s2 + w1 * np.outer(m1 - mean, m1 - mean) + w2 * np.outer(m2 - mean, m2 - mean)
-    _evals, evecs = np.linalg.eigh(scatter)
-    normal = evecs[:, 0]
-    if normal @ ref.normal < 0:  # keep the reference's side
-        normal = -normal
-    rho = float(normal @ mean)
-    if rho < 0:
-        normal, rho = -normal, -rho
-    u = np.array([-normal[1], normal[0]])
-    t = np.array([ref.sp @ u, ref.ep @ u, new.sp @ u, new.ep @ u])
+    theta = tls_normal_angle(scatter[0, 0], scatter[1, 1], scatter[0, 1])
+    if np.cos(theta - ref.theta) < 0:  # keep the reference's side
+        theta += np.pi
+    rho, theta = (float(v) for v in normalize_line(mean @ [np.cos(theta), np.sin(theta)], theta))
+    t = position_on_line(np.array([ref.sp, ref.ep, new.sp, new.ep]), theta)
     lo, hi = (t.min(), t.max()) if t[0] <= t[1] else (t.max(), t.min())
-    base = rho * normal
-    sp, ep = base + lo * u, base + hi * u
+    sp, ep = point_on_line(rho, theta, np.array([lo, hi]))
     return Line(
         rho=rho,
-        theta=float(np.mod(np.arctan2(normal[1], normal[0]), 2 * np.pi)),
+        theta=theta,
         n=ref.n + new.n,
         length=float(abs(hi - lo)),
         sp=sp,

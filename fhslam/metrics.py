@@ -33,7 +33,15 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from fhslam.geometry import inverse, line_through, relative, transform_points, wrap_angle
+from fhslam.geometry import (
+    distance_to_segments,
+    inverse,
+    line_through,
+    ray_segment_intersection,
+    relative,
+    transform_points,
+    wrap_angle,
+)
 from fhslam.lines import Line
 from fhslam.scan import scan_to_points
 
@@ -556,8 +564,6 @@ def rpe_rot_deg(
 # Map metrics: the SLAM map's line segments against the world's true walls
 # ==========================================================================================
 
-_CHUNK = 1 << 20  # elements of a (points x segments) block
-
 
 def as_segments(lines: Sequence[Line] | ArrayLike) -> NDArray[np.float64]:
     """Segments ``[x1, y1, x2, y2]`` (M, 4) from Lines (``sp``, ``ep``) or an (M, 4) array."""
@@ -596,36 +602,6 @@ def sample_segments(segments: ArrayLike, step: float = 0.05) -> NDArray[np.float
     k = np.arange(len(seg)) - first[seg]
     t = (k / n[seg])[:, None]
     return a[seg] + t * (b[seg] - a[seg])
-
-
-def distance_to_segments(points: ArrayLike, segments: ArrayLike) -> NDArray[np.float64]:
-    """Distance from each point to the nearest of the segments, metres.
-
-    Broadcasts points against segments in blocks of about a million pairs.
-
-    Parameters
-    ----------
-    points : array-like, shape (P, 2)
-    segments : array-like, shape (M, 4), M >= 1
-
-    Returns
-    -------
-    ndarray, shape (P,)
-    """
-    p = np.asarray(points, dtype=float).reshape(-1, 2)
-    s = as_segments(segments)
-    if len(s) == 0:
-        raise ValueError("distance_to_segments needs at least one segment")
-    a, ab = s[:, :2], s[:, 2:] - s[:, :2]  # (M, 2)
-    denom = np.maximum(np.einsum("ij,ij->i", ab, ab), 1e-300)
-    out = np.empty(len(p))
-    rows = max(1, _CHUNK // len(s))
-    for lo in range(0, len(p), rows):
-        q = p[lo : lo + rows, None, :] - a  # (R, M, 2)
-        t = np.clip(np.einsum("rmk,mk->rm", q, ab) / denom, 0.0, 1.0)
-        d = q - t[..., None] * ab
-        out[lo : lo + rows] = np.sqrt(np.min(np.einsum("rmk,rmk->rm", d, d), axis=1))
-    return out
 
 
 def map_error(lines: Sequence[Line] | ArrayLike, walls: ArrayLike, step: float = 0.05) -> float:
@@ -696,8 +672,7 @@ def _beam_wall_points(
     o = poses[k, :2]
     a = angles[b] + poses[k, 2]
     d = np.column_stack([np.cos(a), np.sin(a)])
-    p, e = w[:, :2] - o, w[:, 2:] - w[:, :2]
-    t = (p[:, 0] * e[:, 1] - p[:, 1] * e[:, 0]) / (d[:, 0] * e[:, 1] - d[:, 1] * e[:, 0])
+    t, _ = ray_segment_intersection(o, d, w[:, :2], w[:, 2:])
     return o + t[:, None] * d
 
 

@@ -26,7 +26,15 @@ from numpy.typing import ArrayLike, NDArray
 from tqdm.auto import tqdm
 
 from fhslam.extraction import ExtractionParams, extract_lines
-from fhslam.geometry import as_pose, compose, inverse, relative, signed_distance, wrap_angle
+from fhslam.geometry import (
+    as_pose,
+    compose,
+    inverse,
+    point_segment_distance,
+    relative,
+    signed_distance,
+    wrap_angle,
+)
 from fhslam.io.log import scan_of
 from fhslam.lines import Line, transform_lines
 from fhslam.matching import MatchParams, match_lines, merge
@@ -336,11 +344,7 @@ class FastHoughSLAM:
         m = self.params.matching
         reach = max(max(np.hypot(*ln.sp), np.hypot(*ln.ep)) for ln in observed)
         reach += m.max_distance + max(0.0, -m.min_overlap) + 1e-6
-        a, d = ends[:, :2] - pose[:2], ends[:, 2:] - ends[:, :2]
-        t = np.clip(
-            -np.einsum("ij,ij->i", a, d) / np.maximum(np.einsum("ij,ij->i", d, d), 1e-18), 0, 1
-        )
-        dist = np.hypot(a[:, 0] + t * d[:, 0], a[:, 1] + t * d[:, 1])
+        dist = point_segment_distance(pose[:2], ends[:, :2], ends[:, 2:])
         return np.flatnonzero(dist <= reach)
 
     def _add_references(self, observed: Sequence[Line], pose: NDArray, match: NDArray) -> int:

@@ -13,20 +13,13 @@ ROOM = np.array([[0, 0, 6, 0], [6, 0, 6, 4], [6, 4, 0, 4], [0, 4, 0, 0]], dtype=
 
 
 def cast(walls: np.ndarray, pose, n_beams: int = 181, noise: float = 0.01, seed: int = 0):
-    """Ranges of a 180° laser at ``pose`` in a world of wall segments (test-only caster)."""
-    x, y, th = pose
+    """Ranges of a 180° laser at ``pose`` in a world of wall segments (inf: no wall hit),
+    with Gaussian range noise; and the bearings."""
+    from fhslam.sim import cast_rays
+
     a = np.radians(np.linspace(-90, 90, n_beams))
-    d = np.column_stack([np.cos(a + th), np.sin(a + th)])
-    p, q = walls[:, :2], walls[:, 2:]
-    e = q - p
-    denom = d[:, None, 0] * e[None, :, 1] - d[:, None, 1] * e[None, :, 0]
-    w = p[None] - np.array([x, y])
-    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
-        t = (w[..., 0] * e[None, :, 1] - w[..., 1] * e[None, :, 0]) / denom
-        s = (w[..., 0] * d[:, None, 1] - w[..., 1] * d[:, None, 0]) / denom
-    t = np.where((t > 0) & (s >= 0) & (s <= 1), t, np.inf)
-    r = t.min(axis=1) + np.random.default_rng(seed).normal(0, noise, n_beams)
-    return r, a
+    r, _ = cast_rays(walls, pose, a, max_range=np.inf)
+    return r + np.random.default_rng(seed).normal(0, noise, n_beams), a
 
 
 def room_points(pose=(2.0, 1.5, 0.3), noise=0.01, seed=0):

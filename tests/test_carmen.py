@@ -19,6 +19,7 @@ from fhslam.io import (
     write_carmen,
     write_trajectory,
 )
+from fhslam.io.log import no_return_reading
 from fhslam.sim import LaserParams, paper_world, simulate
 
 
@@ -79,11 +80,28 @@ def test_other_fields_of_view_round_trip_through_robotlaser1(tmp_path):
     assert back.max_range == 10.0
 
 
-def test_flaser_angle_convention():
-    np.testing.assert_allclose(np.diff(flaser_angles(181)), np.radians(1.0), atol=1e-12)
-    np.testing.assert_allclose(np.diff(flaser_angles(361)), np.radians(0.5), atol=1e-12)
-    np.testing.assert_allclose(np.diff(flaser_angles(180)), np.pi / 179, atol=1e-12)
-    assert flaser_angles(181)[0] == -np.pi / 2 and flaser_angles(181)[-1] == np.pi / 2
+@pytest.mark.parametrize(
+    ("n", "step_deg", "last_deg"),
+    [(181, 1.0, 90.0), (180, 1.0, 89.0), (361, 0.5, 90.0), (360, 0.5, 89.5), (401, 0.25, 10.0),
+     (91, 2.0, 90.0)],
+)  # fmt: skip
+def test_flaser_angles_follow_carmens_guess(n, step_deg, last_deg):
+    """CARMEN's carmen_laser_guess_angle_increment: from -90° in 1° (180/181 beams), 0.5°
+    (360/361), 0.25° (400/401) steps; any other count spreads over 180°."""
+    a = flaser_angles(n)
+    assert a[0] == -np.pi / 2
+    np.testing.assert_allclose(np.diff(a), np.radians(step_deg), rtol=0, atol=1e-12)
+    assert np.degrees(a[-1]) == pytest.approx(last_deg, abs=1e-9)
+    if n in (181, 361):
+        assert a[-1] == np.pi / 2  # exactly, as the simulator's beams
+
+
+def test_clf_and_converted_bags_share_one_bearing_rule():
+    """A bag converted from a 180-beam FLASER log (increment π/179 as the converter wrote
+    it) gets the same bearings as the FLASER line itself."""
+    from fhslam.io import rosbag
+
+    assert rosbag.flaser_angles is flaser_angles
 
 
 def test_read_mit_csail():
@@ -121,7 +139,7 @@ def test_read_skips_comments_blank_lines_and_other_messages(tmp_path):
     assert log.ranges.shape == (3, 5) and log.ranges[2].tolist() == [1.2, 1.7, 2.2, 2.7, 3.2]
     assert log.odometry[1].tolist() == [0.1, 0.0, 0.01]
     assert np.array_equal(log.angles, np.linspace(-np.pi / 2, np.pi / 2, 5))
-    assert log.max_range == 8.0  # max(8.0, largest reading 3.2)
+    assert log.max_range == 80.0  # no "no return" code: CARMEN's FLASER default
     assert read_carmen(path, max_range=4.0).max_range == 4.0
 
 
@@ -261,3 +279,62 @@ def test_trajectory_empty_and_missing(tmp_path):
         read_trajectory(tmp_path / "absent.txt")
     with pytest.raises(ValueError, match="poses must have shape"):
         write_trajectory(path, [0.0, 1.0], [[0.0, 0.0, 0.0]])
+
+
+# ---------------------------------------------------------------------------- max range
+
+
+def _flaser_log(rows: list[list[float]]) -> str:
+    return "".join(
+        f"FLASER {len(r)} {' '.join(map(str, r))} 0 0 0 0 0 0 {k + 1}.0 host {k + 1}.0\n"
+        for k, r in enumerate(rows)
+    )
+
+
+def test_no_return_code_below_noisy_long_returns_is_found(tmp_path):
+    """A log whose no-return code (50.0 m) is exceeded by a few noisy real readings: the
+    code, not the largest reading, is the maximum range, so no-return beams give no points
+    (before issue 9: max range 50.3 m and a phantom arc of points at 50 m)."""
+    rng = np.random.default_rng(0)
+    rows = []
+    for k in range(400):
+        r = np.round(rng.uniform(0.5, 12.0, 181), 2)
+        r[rng.random(181) < 0.2] = 50.0  # no return
+        if k % 50 == 0:
+            r[90] = 50.3 + 0.01 * (k // 50)  # a rare, noisy long return
+        rows.append(r.tolist())
+    path = tmp_path / "code50.clf"
+    path.write_text(_flaser_log(rows))
+    log = read_carmen(path)
+    assert log.max_range == 50.0
+    assert no_return_reading(log.ranges) == 50.0
+    pts = [log.scan(k).points()[0] for k in range(len(log))]
+    assert max(np.hypot(*p.T).max() for p in pts) < 12.0 + 1e-9  # no phantom at 50 m
+
+
+def test_the_lowest_of_two_codes_is_the_maximum_range():
+    """The Freiburg hospital codes no return as 81.83 and 81.91 m."""
+    rng = np.random.default_rng(1)
+    r = np.round(rng.uniform(0.3, 30.0, (300, 180)), 2)
+    r[rng.random(r.shape) < 0.10] = 81.91
+    r[rng.random(r.shape) < 0.01] = 81.83
+    assert no_return_reading(r) == 81.83
+
+
+@pytest.mark.parametrize(
+    "ranges",
+    [
+        np.array([[1.0, 1.5, 2.0, 2.5, 3.0], [1.1, 1.6, 2.1, 2.6, 3.1]]),  # all distinct
+        np.round(np.random.default_rng(2).uniform(0.2, 7.9, (50, 181)), 3),  # no code
+        np.full((2, 3), np.nan),  # nothing valid
+    ],
+)
+def test_logs_without_a_code_have_none(ranges):
+    assert no_return_reading(ranges) is None
+
+
+def test_max_range_can_be_overridden_and_is_reported(tmp_path):
+    path = tmp_path / "small.clf"
+    path.write_text(GOOD)
+    assert read_carmen(path, max_range=2.05).max_range == 2.05
+    assert len(read_carmen(path, max_range=2.05).scan(0).points()[0]) == 3  # 1.0 1.5 2.0

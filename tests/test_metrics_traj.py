@@ -9,14 +9,13 @@ import numpy as np
 import pytest
 from conftest import ROOM
 
-from fhslam.geometry import compose, transform_points
+from fhslam.geometry import compose, distance_to_segments, transform_points
 from fhslam.io import MapFormatError, lines_from_segments, read_map, write_map
 from fhslam.metrics import (
     ErrorStats,
     align_se2,
     associate,
     ate,
-    distance_to_segments,
     error_stats,
     map_coverage,
     map_error,

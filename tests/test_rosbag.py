@@ -129,7 +129,6 @@ def test_an_interlaced_laser_gets_per_scan_bearing_offsets(tmp_path):
     """Scans starting a quarter beam apart (181, 180, 180, 180 beams) read into one Log
     whose ``scan(k)`` bearings put every point back on the wall x = 2 m."""
     from fhslam.io import write_carmen
-    from fhslam.scan import scan_to_points
 
     log = read_bag(write_bag(tmp_path / "i.bag", scans=6, interlaced=True))
     inc = np.pi / 180
@@ -138,7 +137,7 @@ def test_an_interlaced_laser_gets_per_scan_bearing_offsets(tmp_path):
     )
     assert log.ranges.shape == (6, 181) and np.isnan(log.ranges[1, -1])
     for k in range(6):
-        pts, _ = scan_to_points(*log.scan(k), max_range=log.max_range)
+        pts, _ = log.scan(k).points()
         np.testing.assert_allclose(pts[:, 0], 2.0, atol=1e-5)
     with pytest.raises(ValueError, match="per-scan bearing offsets"):
         write_carmen(log, tmp_path / "i.clf")

@@ -27,7 +27,14 @@ from numpy.typing import ArrayLike, NDArray
 from tqdm.auto import tqdm
 
 from fhslam.extraction import ExtractionParams, extract_lines
-from fhslam.geometry import as_pose, compose, relative, wrap_angle
+from fhslam.geometry import (
+    as_pose,
+    compose,
+    point_on_line,
+    position_on_line,
+    relative,
+    wrap_angle,
+)
 from fhslam.io.log import scan_of
 from fhslam.lines import Line
 from fhslam.scan import scan_to_points
@@ -323,8 +330,7 @@ class EKFLineSLAM:
         """
         w = ln.transformed(self.ekf.x[:3])
         pts = np.vstack([self._ends[j], w.sp, w.ep])
-        a = self.ekf.x[3 + 2 * j]
-        t = pts @ np.array([-np.sin(a), np.cos(a)])
+        t = position_on_line(pts, self.ekf.x[3 + 2 * j])
         self._ends[j] = pts[[int(np.argmin(t)), int(np.argmax(t))]]
         self._support[j] += ln.n
 
@@ -344,10 +350,8 @@ class EKFLineSLAM:
         out = []
         for j in range(self.n_landmarks):
             a, r = self.ekf.x[3 + 2 * j : 5 + 2 * j]
-            n = np.array([np.cos(a), np.sin(a)])
-            u = np.array([-n[1], n[0]])
-            lo, hi = np.sort(self._ends[j] @ u)
-            sp, ep = r * n + lo * u, r * n + hi * u
+            lo, hi = np.sort(position_on_line(self._ends[j], a))
+            sp, ep = point_on_line(r, a, np.array([lo, hi]))
             out.append(
                 Line(rho=float(r), theta=float(a), n=self._support[j], length=float(hi - lo),
                      sp=sp, ep=ep)

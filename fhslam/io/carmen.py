@@ -29,26 +29,39 @@ import numpy as np
 from numpy.typing import NDArray
 
 from fhslam.geometry import relative, wrap_angle
-from fhslam.io.log import Log, is_number
+from fhslam.io.log import Log, effective_max_range, is_number
 
 HOSTNAME = "fhslam"
-DEFAULT_MAX_RANGE = 8.0
+FLASER_MAX_RANGE = 80.0
+"""CARMEN's assumed maximum range of an old ``FLASER`` laser, metres."""
 
 
 class CarmenFormatError(ValueError):
     """A malformed CARMEN log. The message reads ``"{path}:{lineno}: {what is wrong}"``."""
 
 
-def flaser_angles(n: int) -> NDArray[np.float64]:
-    """Bearings of an old-format ``FLASER`` scan of ``n`` beams: ``linspace(-pi/2, pi/2, n)``.
+_GUESSED_INCREMENT = {180: 1.0, 181: 1.0, 360: 0.5, 361: 0.5, 400: 0.25, 401: 0.25}
+"""CARMEN's ``carmen_laser_guess_angle_increment``: degrees between beams by beam count."""
 
-    The message carries no angles; the convention (also used by the ``carmen_to_rosbag``
-    converter of the reference datasets) is a 180 degree scan from the right (-90 degrees) to
-    the left (+90 degrees), both ends included: an increment of pi/(n-1), i.e. exactly 1 degree
-    for 181 beams and 0.5 degree for 361. For 180-beam logs this gives pi/179 (about 1.006
-    degrees), not 1 degree.
+
+def flaser_angles(n: int) -> NDArray[np.float64]:
+    """Bearings of an old-format ``FLASER`` scan of ``n`` beams, by CARMEN's own rule.
+
+    The message carries no angles. CARMEN's log reader (``carmen_string_to_robot_laser_
+    message_orig``: ``start_angle = -M_PI / 2`` and ``carmen_laser_guess_angle_increment``)
+    assumes a scan starting at -90° (the right) in steps of 1° for 180 or 181 beams, 0.5° for
+    360 or 361 and 0.25° for 400 or 401; any other count spreads over 180°, both ends
+    included. So 181 beams span -90°..+90°, but 180 beams -90°..+89° (the last beam of a
+    180° scan is not sent), not 180° in steps of 180°/179.
+
+    The same rule reads bags converted from such logs (:func:`fhslam.io.read_bag`), whose
+    converter wrote ``angle_increment = π/(n−1)`` without knowing better.
     """
-    return np.linspace(-np.pi / 2, np.pi / 2, n)
+    step = _GUESSED_INCREMENT.get(n)
+    span = np.pi if step is None else np.radians(step) * (n - 1)
+    if n in (181, 361):
+        span = np.pi  # exactly: the last bearing is +90°
+    return np.linspace(-np.pi / 2, -np.pi / 2 + span, n)
 
 
 # ----------------------------------------------------------------------------------- writing
@@ -241,9 +254,10 @@ def read_carmen(path: str | PathLike[str], max_range: float | None = None) -> Lo
         The ``.clf``/``.log`` file.
     max_range : float, optional
         The laser's maximum range in metres (readings at or beyond it mean "no return").
-        Default: for ``ROBOTLASER1`` its ``maximum_range`` field; for ``FLASER`` (which does
-        not record it) ``max(8.0, largest reading in the file)``, so the "no return" code of
-        a log (e.g. 81.91 m in mit-csail) becomes the maximum range.
+        Default: the log's "no return" code (:func:`fhslam.io.log.no_return_reading`, e.g.
+        81.91 m in mit-csail), or for ``ROBOTLASER1`` its ``maximum_range`` field if that is
+        smaller; a ``FLASER`` log without a code gets CARMEN's assumption for ``FLASER``,
+        80 m (or more, above its largest reading).
 
     Returns
     -------
@@ -308,11 +322,10 @@ def read_carmen(path: str | PathLike[str], max_range: float | None = None) -> Lo
     r = np.vstack(ranges)
     if kind == "FLASER":
         angles = flaser_angles(n)
-        finite = r[np.isfinite(r)]
-        inferred = max(DEFAULT_MAX_RANGE, float(finite.max())) if finite.size else DEFAULT_MAX_RANGE
+        inferred, _ = effective_max_range(r, None, FLASER_MAX_RANGE)
     else:
         angles = geom[0] + np.arange(n) * geom[1]
-        inferred = float(geom[2])
+        inferred, _ = effective_max_range(r, float(geom[2]), float(geom[2]))
     return Log(
         name=path.stem,
         timestamps=np.array(stamps),

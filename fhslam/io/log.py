@@ -12,13 +12,12 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from os import PathLike
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import Any
 
 import numpy as np
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 
-if TYPE_CHECKING:  # io must not depend on sim at run time
-    from fhslam.sim.world import World
+from fhslam.scan import Scan
 
 
 @dataclass(eq=False)
@@ -45,8 +44,9 @@ class Log:
         Ground-truth pose at each scan (simulated logs only).
     hits : ndarray of int, shape (T, B), or None
         Index of the wall of ``world`` hit by each beam, -1 for no return (simulated only).
-    world : World or None
-        The world the log was simulated in.
+    world : fhslam.sim.World or None
+        The world the log was simulated in (typed loosely: :mod:`fhslam.io` sits below
+        :mod:`fhslam.sim` and never imports it).
     laser_offset : ndarray, shape (3,)
         Pose of the laser on the robot, ``robot_T_laser`` (zero: the laser at the robot's
         origin). SLAM estimates laser poses ``odometry ⊕ laser_offset`` and reports robot
@@ -65,7 +65,7 @@ class Log:
     max_range: float
     truth: NDArray[np.float64] | None = None
     hits: NDArray[np.intp] | None = None
-    world: World | None = None
+    world: Any = None
     laser_offset: NDArray[np.float64] | None = None
     angle_offsets: NDArray[np.float64] | None = None
 
@@ -119,12 +119,11 @@ class Log:
         """Number of beams per scan B."""
         return len(self.angles)
 
-    def scan(self, k: int) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-        """Scan ``k`` as ``(ranges (B,), angles (B,))`` in the laser frame (``angles`` plus
-        the scan's ``angle_offsets`` entry, if any)."""
-        if self.angle_offsets is None:
-            return self.ranges[k], self.angles
-        return self.ranges[k], self.angles + self.angle_offsets[k]
+    def scan(self, k: int) -> Scan:
+        """Scan ``k`` in the laser frame, with the log's ``max_range`` (its bearings are
+        ``angles`` plus the scan's ``angle_offsets`` entry, if any)."""
+        angles = self.angles if self.angle_offsets is None else self.angles + self.angle_offsets[k]
+        return Scan(self.ranges[k], angles, self.max_range)
 
     def __repr__(self) -> str:
         duration = self.timestamps[-1] - self.timestamps[0] if len(self) else 0.0
@@ -133,6 +132,70 @@ class Log:
             f"Log({self.name!r}: {len(self)} scans x {self.n_beams} beams, {duration:.1f} s, "
             f"max_range={self.max_range:g} m{', with ' + ' and '.join(extras) if extras else ''})"
         )
+
+
+NO_RETURN_MIN_SHARE = 1e-3
+"""Smallest share of a log's valid beams that must read one exact value for
+:func:`no_return_reading` to take it as the "no return" code."""
+
+
+def no_return_reading(ranges: ArrayLike, min_share: float = NO_RETURN_MIN_SHARE) -> float | None:
+    """The reading a log uses to say "no return", or ``None`` if it has none.
+
+    A laser reports a beam without an echo as one fixed code, and a CARMEN ``FLASER`` line
+    does not say which: 81.91 m (and 81.83 m) in the Freiburg logs of a SICK LMS in its
+    80 m mode, 50.0 m in ACES, the maximum range in a simulated log. Real returns that far
+    are sparse and scattered; a code is one exact value read over and over. Among the values
+    in the upper half of the readings' scale (at least half the largest reading):
+
+    1. the smallest value read by at least ``min_share`` of all valid beams (and by at least
+       20) is the code;
+    2. failing that, the largest reading is the code if it was read at least twice (a short
+       log with few no-return beams; at worst a few real returns at the very top are lost).
+
+    The largest reading alone is no evidence: a few long noisy returns beyond the code would
+    turn every no-return beam into a phantom point.
+
+    Parameters
+    ----------
+    ranges : array-like
+        Every reading of the log, metres (NaN/inf and non-positive ones are ignored).
+    min_share : float
+        See above.
+
+    Returns
+    -------
+    float or None
+        The code; readings at or above it are "no return".
+    """
+    r = np.asarray(ranges, dtype=float).ravel()
+    r = r[np.isfinite(r) & (r > 0)]
+    if r.size == 0:
+        return None
+    values, counts = np.unique(r[r >= 0.5 * r.max()], return_counts=True)
+    spikes = values[counts >= max(20.0, min_share * r.size)]
+    if spikes.size:
+        return float(spikes[0])
+    if counts[-1] >= 2:
+        return float(values[-1])
+    return None
+
+
+def effective_max_range(
+    ranges: ArrayLike, stated: float | None, default: float
+) -> tuple[float, float | None]:
+    """The maximum range a reader gives a log: the smaller of the range the file states
+    (``stated``, e.g. a bag's ``range_max``) and its detected no-return code
+    (:func:`no_return_reading`); with neither, ``default``, raised above the largest reading
+    if needed so that no real reading is dropped. Returns ``(max_range, code)``."""
+    code = no_return_reading(ranges)
+    candidates = [v for v in (stated, code) if v is not None]
+    if candidates:
+        return min(candidates), code
+    r = np.asarray(ranges, dtype=float)
+    finite = r[np.isfinite(r)]
+    top = float(finite.max()) if finite.size else 0.0
+    return (default if default > top else float(np.nextafter(top, np.inf))), None
 
 
 def is_number(token: str) -> bool:
@@ -204,4 +267,7 @@ def scan_of(log, k: int) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """Scan ``k`` of ``log`` as ``(ranges, angles)``: :meth:`Log.scan` for a :class:`Log`,
     ``(log.ranges[k], log.angles)`` for any other object with those attributes."""
     scan = getattr(log, "scan", None)
-    return scan(k) if callable(scan) else (log.ranges[k], log.angles)
+    if not callable(scan):
+        return log.ranges[k], log.angles
+    s = scan(k)
+    return s.ranges, s.angles

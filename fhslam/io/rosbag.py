@@ -8,9 +8,14 @@ pose interpolated at its header stamp; the laser's mount on the robot comes from
 Beam angles. Bags converted from old CARMEN ``FLASER`` logs carry no real angle information:
 the converter wrote ``angle_min = -π/2`` and ``angle_increment = π/(n−1)``. For such scans
 (``beams="carmen"``, the default) fhslam uses CARMEN's own rule instead — "if no information
-is given, assume 1.0° resolution": ``-90° + k · 1°`` for up to 181 beams and ``-90° + k · 0.5°``
-for up to 361 (for 181 and 361 beams the two rules agree). A bag whose increment is anything
-else (e.g. from ``ROBOTLASER1`` lines, which state it) is taken as it is.
+is given, assume 1.0° resolution": :func:`fhslam.io.flaser_angles`, the same rule as for
+``.clf`` files (``-90° + k · 1°`` for 180 or 181 beams, ``-90° + k · 0.5°`` for 360 or 361; for
+181 and 361 beams it agrees with the converter). A bag whose increment is anything else (e.g.
+from ``ROBOTLASER1`` lines, which state it) is taken as it is.
+
+Maximum range: the bag's ``range_max``, or the log's detected "no return" code if smaller
+(:func:`fhslam.io.log.no_return_reading`; the Freiburg hospital bag states 81.9 m but codes
+no return as 81.83 and 81.91 m).
 An interlaced laser, whose scans share the increment but start up to one beam apart (the
 Freiburg hospital log: four layouts a quarter degree apart, 181 or 180 beams), is read with
 the first layout's bearings and a per-scan ``Log.angle_offsets``; other mixed layouts are
@@ -26,7 +31,8 @@ import numpy as np
 from numpy.typing import NDArray
 
 from fhslam.geometry import wrap_angle
-from fhslam.io.log import Log
+from fhslam.io.carmen import flaser_angles
+from fhslam.io.log import Log, effective_max_range
 
 SCAN_TYPE = "sensor_msgs/msg/LaserScan"
 ODOM_TYPE = "nav_msgs/msg/Odometry"
@@ -74,18 +80,12 @@ def _pick(reader, msgtype: str, topic: str | None, what: str, path: Path):
     return conns
 
 
-def carmen_beam_angles(n: int) -> NDArray[np.float64]:
-    """CARMEN's bearings for an old FLASER scan of ``n`` beams: 1° steps from -90° up to 181
-    beams, 0.5° steps up to 361."""
-    step = 1.0 if n <= 181 else 0.5
-    return np.radians(-90.0 + step * np.arange(n))
-
-
 def read_bag(
     path: str | PathLike[str],
     scan_topic: str | None = None,
     odom_topic: str | None = None,
     beams: str = "carmen",
+    max_range: float | None = None,
 ) -> Log:
     """Read a ROS 1/2 bag into a :class:`Log` (timestamps = the scans' header stamps).
 
@@ -97,6 +97,9 @@ def read_bag(
         Topics to use; found by message type when omitted.
     beams : {"carmen", "bag"}
         Bearing convention for bags converted from old CARMEN logs (see the module docs).
+    max_range : float, optional
+        The laser's maximum range, metres (readings at or beyond it mean "no return");
+        default: the bag's ``range_max`` or the detected "no return" code (module docs).
 
     Raises
     ------
@@ -107,6 +110,7 @@ def read_bag(
     from rosbags.highlevel import AnyReader
     from rosbags.typesys import Stores, get_typestore
 
+    max_range_override = max_range
     if beams not in ("carmen", "bag"):
         raise ValueError(f"beams must be 'carmen' or 'bag', got {beams!r}")
     p = Path(path)
@@ -151,7 +155,11 @@ def read_bag(
     for k, r in enumerate(ranges):
         rr[k, : len(r)] = r  # shorter scans of the same layout: missing beams are invalid
     converted = abs(inc - np.pi / (n - 1)) < 1e-6
-    angles = carmen_beam_angles(n) if beams == "carmen" and converted else a0 + inc * np.arange(n)
+    angles = flaser_angles(n) if beams == "carmen" and converted else a0 + inc * np.arange(n)
+    if max_range_override is None:
+        max_range, _ = effective_max_range(rr, max_range, max_range)
+    else:
+        max_range = float(max_range_override)
     t = np.asarray(stamps)
     order = np.argsort(t, kind="stable")
     return Log(

@@ -12,7 +12,6 @@ from fhslam.sim.world import (
     paper_world,
     random_world,
     route_clearance,
-    segment_distances,
 )
 
 __all__ = [
@@ -33,6 +32,5 @@ __all__ = [
     "paper_world",
     "random_world",
     "route_clearance",
-    "segment_distances",
     "simulate",
 ]

@@ -12,7 +12,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from fhslam.geometry import as_pose
+from fhslam.geometry import as_pose, ray_segment_intersection
 
 
 @dataclass(frozen=True)
@@ -70,9 +70,9 @@ def cast_rays(
 ) -> tuple[NDArray[np.float64], NDArray[np.intp]]:
     """Exact ranges from ``pose`` along each beam to the nearest wall.
 
-    Solves ``o + t d = p + s (q - p)`` for every beam (direction ``d``) and every wall
-    ``[p, q]`` at once, as a (B, M) array: ``t`` is the range, and the hit is valid when
-    ``t > 0`` and ``0 <= s <= 1``. Beams parallel to a wall never hit it.
+    :func:`fhslam.geometry.ray_segment_intersection` of every beam with every wall at once,
+    as a (B, M) array: ``t`` is the range, and the hit is valid when ``t > 0`` and
+    ``0 <= s <= 1``. Beams parallel to a wall never hit it.
 
     Parameters
     ----------
@@ -95,14 +95,9 @@ def cast_rays(
     w = np.asarray(walls, dtype=float).reshape(-1, 4)
     x, y, th = as_pose(pose)
     a = np.asarray(angles, dtype=float) + th
-    dx, dy = np.cos(a)[:, None], np.sin(a)[:, None]  # (B, 1) beam directions
-    px, py = w[:, 0] - x, w[:, 1] - y  # (M,) wall starts relative to the laser
-    ex, ey = w[:, 2] - w[:, 0], w[:, 3] - w[:, 1]  # (M,) wall direction vectors
-    denom = dx * ey - dy * ex  # cross(d, e), (B, M)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        t = (px * ey - py * ex) / denom  # cross(p, e) / cross(d, e)
-        s = (px * dy - py * dx) / denom  # cross(p, d) / cross(d, e)
-    valid = (denom != 0) & (t > 0) & (s >= 0) & (s <= 1) & (t < max_range)
+    d = np.stack([np.cos(a), np.sin(a)], axis=-1)[:, None, :]  # (B, 1, 2) beam directions
+    t, s = ray_segment_intersection((x, y), d, w[:, :2], w[:, 2:])  # (B, M) each
+    valid = np.isfinite(t) & (t > 0) & (s >= 0) & (s <= 1) & (t < max_range)
     t = np.where(valid, t, np.inf)
     if w.shape[0] == 0:  # no walls: nothing to hit
         return np.full(len(a), float(max_range)), np.full(len(a), -1, dtype=np.intp)

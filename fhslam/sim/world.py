@@ -20,9 +20,9 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import NDArray
 
-from fhslam.geometry import transform_points
+from fhslam.geometry import segment_distances, transform_points
 
 BUILTIN_WORLDS = ("paper", "random:SEED")
 
@@ -157,37 +157,6 @@ class World:
 
 
 # ----------------------------------------------------------------------------- geometry
-
-
-def _point_segment(p: NDArray, a: NDArray, b: NDArray) -> NDArray[np.float64]:
-    """Distance from points ``p`` to segments ``a``-``b``; all (..., 2), broadcast."""
-    ab = b - a
-    denom = np.maximum((ab * ab).sum(-1), 1e-300)
-    t = np.clip(((p - a) * ab).sum(-1) / denom, 0.0, 1.0)
-    return np.linalg.norm(p - (a + t[..., None] * ab), axis=-1)
-
-
-def segment_distances(s: ArrayLike, t: ArrayLike) -> NDArray[np.float64]:
-    """Shortest distance between every segment of ``s`` (N, 4) and of ``t`` (M, 4): (N, M).
-
-    Zero where two segments cross; otherwise the smallest endpoint-to-segment distance.
-    """
-    s = np.asarray(s, dtype=float).reshape(-1, 4)
-    t = np.asarray(t, dtype=float).reshape(-1, 4)
-    a, b = s[:, None, :2], s[:, None, 2:]
-    c, d = t[None, :, :2], t[None, :, 2:]
-    dist = np.minimum.reduce(
-        [_point_segment(a, c, d), _point_segment(b, c, d), _point_segment(c, a, b),
-         _point_segment(d, a, b)]
-    )  # fmt: skip
-
-    def cross(u: NDArray, v: NDArray) -> NDArray:
-        return u[..., 0] * v[..., 1] - u[..., 1] * v[..., 0]
-
-    crossing = (cross(b - a, c - a) * cross(b - a, d - a) < 0) & (
-        cross(d - c, a - c) * cross(d - c, b - c) < 0
-    )
-    return np.where(crossing, 0.0, dist)
 
 
 def route_segments(world: World) -> NDArray[np.float64]:

@@ -30,23 +30,25 @@ def _simulate(args: argparse.Namespace) -> None:
     print(f"wrote {len(log)} scans to {args.log} and the true poses to {args.truth}")
 
 
+def _load(args: argparse.Namespace):
+    from fhslam.datasets import load_log
+
+    return load_log(
+        args.log, args.scan_topic, args.odom_topic, args.download, max_range=args.max_range
+    )
+
+
 def _info(args: argparse.Namespace) -> None:
-    import numpy as np
+    from fhslam.evaluate import log_summary
 
-    from fhslam.extraction import extract_lines
-    from fhslam.io import read_carmen
-    from fhslam.scan import scan_to_points
-
-    log = read_carmen(args.log)
-    step = np.hypot(*np.diff(log.odometry[:, :2], axis=0).T).sum()
-    sample = range(0, len(log), max(1, len(log) // 200))
-    n_lines = [
-        len(extract_lines(scan_to_points(log.ranges[k], log.angles, log.max_range)[0]))
-        for k in sample
-    ]
-    print(f"{args.log}: {len(log)} scans of {len(log.angles)} beams")
-    print(f"time span {log.timestamps[-1] - log.timestamps[0]:.1f} s, odometry path {step:.1f} m")
-    print(f"fast Hough lines per scan (median of {len(n_lines)} scans): {np.median(n_lines):g}")
+    log = _load(args)
+    s = log_summary(log)
+    print(f"{args.log}: {s.n_scans} scans of {s.n_beams} beams")
+    print(f"time span {s.duration:.1f} s, odometry path {s.odometry_path:.1f} m")
+    code = "none found" if s.no_return is None else f"{s.no_return:g} m"
+    given = " (--max-range)" if args.max_range is not None else ""
+    print(f"max range {s.max_range:g} m{given}; no-return reading: {code}")
+    print(f"fast Hough lines per scan (median of {s.n_sampled} scans): {s.median_lines:g}")
 
 
 def _stats_rows(stats: dict[str, object]) -> str:
@@ -59,26 +61,12 @@ def _stats_rows(stats: dict[str, object]) -> str:
 
 
 def _evaluate(args: argparse.Namespace) -> None:
-    """Trajectory (and map) errors against the ground truth, or the relations error.
-
-    With ``--truth``: poses are paired by timestamp (``fhslam.metrics.associate``, within
-    ``--max-diff`` s, default 0.01). ATE is not aligned unless ``--align``: the SLAM starts
-    at the true first pose. With ``--world`` and ``--map``, the map is compared with the
-    world's walls: ``map_error`` is the mean distance of the map segments to the walls, and
-    ``map_coverage`` the share of the observed wall points within 5 cm of the map. Nothing is
-    simulated for it: the observed points are the noise-free hits of the paper's laser (181
-    beams over 180 degrees, 8 m) cast into the world from every 5th pose of the truth file.
-
-    With ``--relations``: the Kümmerle et al. (2009) relations error of the trajectory
-    (``fhslam.metrics.relations_error``, relation stamps matched to pose stamps within
-    ``--max-diff`` s, default 0.001), as mean ± std of the absolute and the squared
-    translational (m, m²) and rotational (deg, deg²) errors, Hess et al. (2016) Table II.
-    """
+    """``fhslam evaluate``: :func:`fhslam.evaluate.evaluate_truth` (``--truth``) or
+    :func:`fhslam.evaluate.evaluate_relations` (``--relations``), printed."""
     import json
-    import math
 
-    from fhslam import metrics
-    from fhslam.io import read_map, read_relations, read_trajectory
+    from fhslam.errors import InputError
+    from fhslam.evaluate import evaluate_relations, evaluate_truth
 
     if args.relations is not None:
         given = [
@@ -92,101 +80,61 @@ def _evaluate(args: argparse.Namespace) -> None:
             if value is not None
         ]
         if given:
-            raise ValueError(f"{', '.join(given)}: only with --truth, not with --relations")
+            raise InputError(f"{', '.join(given)}: only with --truth, not with --relations")
         max_diff = 0.001 if args.max_diff is None else args.max_diff
-        t_est, est = read_trajectory(args.trajectory)
-        from fhslam.data import find_dataset
-
-        args.relations = find_dataset(args.relations, kind="relations")
-        t1, t2, rel = read_relations(args.relations)
-        try:
-            rerr = metrics.relations_error(t_est, est, t1, t2, rel, max_diff=max_diff)
-        except ValueError as e:
-            raise ValueError(f"{args.trajectory} and {args.relations}: {e}") from None
+        rep = evaluate_relations(args.trajectory, args.relations, max_diff)
         if args.json:
-            out: dict[str, float | int] = {
-                f"relations_{k}": v
-                for k, v in rerr.as_dict().items()
-                if k not in ("n_used", "n_total")
-            }
-            out.update(relations_used=rerr.n_used, relations_total=rerr.n_total)
-            print(json.dumps(out, allow_nan=False))
+            print(json.dumps(rep.as_dict(), allow_nan=False))
             return
+        e = rep.error
         print(
-            f"{args.trajectory} vs {args.relations} "
+            f"{args.trajectory} vs {rep.relations} "
             f"(relation and pose timestamps matched within {max_diff:g} s)"
         )
         print(
-            f"translational error: {rerr.trans_mean:.4f} ± {rerr.trans_std:.4f} m, "
-            f"squared {rerr.trans_sq_mean:.4f} ± {rerr.trans_sq_std:.4f} m²"
+            f"translational error: {e.trans_mean:.4f} ± {e.trans_std:.4f} m, "
+            f"squared {e.trans_sq_mean:.4f} ± {e.trans_sq_std:.4f} m²"
         )
         print(
-            f"rotational error:    {rerr.rot_mean_deg:.3f} ± {rerr.rot_std_deg:.3f} deg, "
-            f"squared {rerr.rot_sq_mean_deg:.3f} ± {rerr.rot_sq_std_deg:.3f} deg²"
+            f"rotational error:    {e.rot_mean_deg:.3f} ± {e.rot_std_deg:.3f} deg, "
+            f"squared {e.rot_sq_mean_deg:.3f} ± {e.rot_sq_std_deg:.3f} deg²"
         )
-        print(f"{rerr.n_used} of {rerr.n_total} relations used")
+        print(f"{e.n_used} of {e.n_total} relations used")
         return
 
-    max_diff = 0.01 if args.max_diff is None else args.max_diff
-    delta = 1 if args.delta is None else args.delta
     if (args.world is None) != (args.map is None):
         given, missing = ("--world", "--map") if args.map is None else ("--map", "--world")
-        raise ValueError(f"{given} needs {missing}: the map is compared with the world's walls")
-    t_est, est = read_trajectory(args.trajectory)
-    t_ref, ref = read_trajectory(args.truth)
-    i_est, i_ref = metrics.associate(t_est, t_ref, max_diff=max_diff)
-    if len(i_est) < 2:
-        raise ValueError(
-            f"{args.trajectory} and {args.truth}: only {len(i_est)} poses have matching "
-            f"timestamps (within {max_diff:g} s); at least 2 are needed"
-        )
-    e, r = est[i_est], ref[i_ref]
-    stats = {
-        "ate": metrics.ate(e, r, align=args.align),
-        "rpe_trans": metrics.rpe(e, r, delta=delta),
-        "rpe_rot": metrics.rpe_rot_deg(e, r, delta=delta),
-    }
-    result: dict[str, float | int | None] = {}
-    for name, st in stats.items():
-        unit = "_deg" if name == "rpe_rot" else ""
-        result.update({f"{name}_{k}{unit}": v for k, v in st.as_dict().items()})
-    result.update(n_poses=len(i_est), n_est=len(t_est), n_truth=len(t_ref))
-    result["n_rpe_pairs"] = len(metrics.rpe_pairs(len(e), delta))
-
-    if args.world is not None:
-        from fhslam.sim import load_world
-
-        world = load_world(args.world)
-        lines = read_map(args.map)
-        observed = metrics.visible_wall_points(world.walls, ref, every=5)
-        error = metrics.map_error(lines, world.walls)
-        result.update(
-            map_error=None if math.isnan(error) else error,
-            map_coverage=metrics.map_coverage(lines, observed) if len(observed) else None,
-            n_map_lines=len(lines),
-            n_observed_points=len(observed),
-        )
-
+        raise InputError(f"{given} needs {missing}: the map is compared with the world's walls")
+    delta = 1 if args.delta is None else args.delta
+    rep = evaluate_truth(
+        args.trajectory,
+        args.truth,
+        args.world,
+        args.map,
+        max_diff=0.01 if args.max_diff is None else args.max_diff,
+        delta=delta,
+        align=args.align,
+    )
     if args.json:
-        print(json.dumps(result, allow_nan=False))
+        print(json.dumps(rep.as_dict(), allow_nan=False))
         return
     print(
-        f"{args.trajectory} vs {args.truth}: {len(i_est)} poses matched "
-        f"({len(t_est)} estimated, {len(t_ref)} true)"
+        f"{args.trajectory} vs {args.truth}: {rep.n_poses} poses matched "
+        f"({rep.n_est} estimated, {rep.n_truth} true)"
     )
     labels = {"ate": "ATE (m)", "rpe_trans": "RPE trans (m)", "rpe_rot": "RPE rot (deg)"}
     if args.align:
         labels["ate"] = "ATE aligned (m)"
-    print(_stats_rows({labels[k]: v for k, v in stats.items()}))
-    print(f"RPE over {result['n_rpe_pairs']} pairs {delta} frame(s) apart")
-    if args.world is not None:
-        err, cov = result["map_error"], result["map_coverage"]
+    print(_stats_rows({labels[k]: v for k, v in rep.stats.items()}))
+    print(f"RPE over {rep.n_rpe_pairs} pairs {delta} frame(s) apart")
+    if rep.map:
+        err, cov = rep.map["map_error"], rep.map["map_coverage"]
         print(
-            f"map {args.map}: {len(lines)} lines, map error "
+            f"map {args.map}: {rep.map['n_map_lines']} lines, map error "
             + ("n/a" if err is None else f"{err:.4f} m")
             + ", coverage "
             + ("n/a" if cov is None else f"{100 * cov:.1f} %")
-            + f" of {len(observed)} observed wall points"
+            + f" of {rep.map['n_observed_points']} observed wall points"
         )
 
 
@@ -201,11 +149,10 @@ def _reproduce(args: argparse.Namespace) -> None:
 
 
 def _slam(args: argparse.Namespace) -> None:
-    from fhslam.data import load_log
     from fhslam.io import write_map, write_trajectory
-    from fhslam.slam import run_slam
+    from fhslam.pipeline import run_slam
 
-    log = load_log(args.log, args.scan_topic, args.odom_topic, args.download)
+    log = _load(args)
     result = run_slam(log, args.method, progress=not args.quiet and len(log) > 200)
     # Everything is computed before anything is written: bad input leaves no half files.
     write_trajectory(
@@ -221,12 +168,42 @@ def _slam(args: argparse.Namespace) -> None:
 
 
 def _bench(args: argparse.Namespace) -> None:
-    from fhslam.bench import format_slam_table, format_table, run_bench, run_slam_bench
+    from fhslam.experiments.bench import format_slam_table, format_table, run_bench, run_slam_bench
 
     rows = run_bench(scans_per_world=args.scans, repeats=args.repeats, progress=not args.quiet)
     print(format_table(rows))
     print()
     print(format_slam_table(run_slam_bench()))
+
+
+def _positive_metres(text: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"not a number: {text!r}") from None
+    if not (value > 0 and value < float("inf")):
+        raise argparse.ArgumentTypeError(f"must be a positive number of metres, got {text}")
+    return value
+
+
+def _log_arguments(p: argparse.ArgumentParser) -> None:
+    """The options of every command that reads a laser log (``slam``, ``info``)."""
+    p.add_argument(
+        "log", help="CARMEN log (.clf), ROS 1/2 bag, or a dataset name (intel, aces, ...)"
+    )
+    p.add_argument("--scan-topic", help="LaserScan topic of a bag (default: found by type)")
+    p.add_argument("--odom-topic", help="Odometry topic of a bag (default: found by type)")
+    p.add_argument(
+        "--max-range",
+        type=_positive_metres,
+        help="the laser's maximum range, m: readings at or beyond it are no returns "
+        "(default: the bag's range_max or the log's detected no-return reading)",
+    )
+    p.add_argument(
+        "--download",
+        action="store_true",
+        help="fetch a named dataset into the user cache if no local copy is found",
+    )
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -251,16 +228,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.set_defaults(run=_simulate)
 
     p = sub.add_parser("slam", help="run SLAM on a log: trajectory and line map")
-    p.add_argument(
-        "log", help="CARMEN log (.clf), ROS 1/2 bag, or a dataset name (intel, aces, ...)"
-    )
-    p.add_argument("--scan-topic", help="LaserScan topic of a bag (default: found by type)")
-    p.add_argument("--odom-topic", help="Odometry topic of a bag (default: found by type)")
-    p.add_argument(
-        "--download",
-        action="store_true",
-        help="fetch a named dataset into the user cache if no local copy is found",
-    )
+    _log_arguments(p)
     p.add_argument(
         "--method",
         choices=("fht", "graph", "classical", "ekf", "odometry"),
@@ -275,8 +243,10 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.set_defaults(run=_slam)
 
-    p = sub.add_parser("info", help="summarise a CARMEN log: scans, beams, lines per scan")
-    p.add_argument("log", type=Path, help="CARMEN text log (.clf)")
+    p = sub.add_parser(
+        "info", help="summarise a log: scans, beams, max range, no-return code, lines per scan"
+    )
+    _log_arguments(p)
     p.set_defaults(run=_info)
 
     p = sub.add_parser(
@@ -337,14 +307,12 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def main(argv: list[str] | None = None) -> int:
+    from fhslam.errors import InputError
+
     args = build_parser().parse_args(argv)
     try:
         args.run(args)
-    except FileNotFoundError as e:
-        name = e.filename if e.filename is not None else e
-        print(f"fhslam: error: no such file: {name}", file=sys.stderr)
-        return EXIT_BAD_INPUT
-    except (ValueError, OSError) as e:
+    except InputError as e:  # bad input; anything else is a bug and keeps its traceback
         message = " ".join(str(e).split())  # one line, whatever the message
         print(f"fhslam: error: {message}", file=sys.stderr)
         return EXIT_BAD_INPUT

@@ -10,7 +10,7 @@ optimisation minimises ``Σ ρ(e_ij^T Ω_ij e_ij)`` over the poses with the erro
 of ``z``). Edges can carry a Cauchy kernel ``ρ`` so that a wrong loop closure is
 down-weighted instead of bending the whole trajectory. The first node is held fixed (gauge).
 
-Used by :mod:`fhslam.graphslam`; depends only on :mod:`fhslam.geometry`.
+Used by :mod:`fhslam.slam.graph`; depends only on :mod:`fhslam.geometry`.
 """
 
 from __future__ import annotations

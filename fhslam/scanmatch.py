@@ -9,7 +9,7 @@ the coarse optimum. An exhaustive search cannot be caught by a local minimum, wh
 loop closure after a long drift needs; the score says how well the clouds agree, which is
 what decides whether to trust the match.
 
-Used by :mod:`fhslam.graphslam`; depends only on :mod:`fhslam.geometry`. The inner loop is a
+Used by :mod:`fhslam.slam.graph`; depends only on :mod:`fhslam.geometry`. The inner loop is a
 ``numba`` kernel (one pass over angles × shifts × points).
 """
 

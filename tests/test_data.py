@@ -9,8 +9,15 @@ from pathlib import Path
 import pooch
 import pytest
 
-from fhslam import data
-from fhslam.data import DATASETS, Dataset, DatasetNotFoundError, find_dataset, is_held_out, verify
+from fhslam import datasets as data
+from fhslam.datasets import (
+    DATASETS,
+    Dataset,
+    DatasetNotFoundError,
+    find_dataset,
+    is_held_out,
+    verify,
+)
 
 SHARED = Path(__file__).resolve().parents[2] / "shared" / "data"
 
@@ -159,7 +166,7 @@ def test_size_mismatch_is_a_value_error(fake, monkeypatch, recwarn):
 
 
 def test_not_found_lists_places_and_fixes(fake, monkeypatch):
-    monkeypatch.setattr(data, "__file__", str(fake / "site" / "pkg" / "fhslam" / "data.py"))
+    monkeypatch.setattr(data, "__file__", str(fake / "site" / "pkg" / "fhslam" / "datasets.py"))
     with pytest.raises(DatasetNotFoundError) as e:
         find_dataset("fake", kind="relations")
     msg = str(e.value)
@@ -206,7 +213,7 @@ def test_download_of_a_real_entry_uses_its_github_url(fake, monkeypatch):
         seen.update(url=url, known_hash=known_hash)
         return str(fake / "whatever")
 
-    monkeypatch.setattr(data, "__file__", str(fake / "site" / "pkg" / "fhslam" / "data.py"))
+    monkeypatch.setattr(data, "__file__", str(fake / "site" / "pkg" / "fhslam" / "datasets.py"))
     monkeypatch.setattr(pooch, "retrieve", retrieve)
     find_dataset("aces", kind="relations", download=True)
     assert seen == {

@@ -7,15 +7,16 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from fhslam.baselines.ekf_slam import (
+from fhslam.geometry import inverse
+from fhslam.lines import line_from_points
+from fhslam.scan import Scan
+from fhslam.slam.ekf import (
     EKFLineSLAM,
     line_covariance,
     measurement_jacobian,
     predict_measurement,
     residual,
 )
-from fhslam.geometry import inverse
-from fhslam.lines import line_from_points
 
 
 def numeric_jacobian(x, j, eps=1e-6):
@@ -78,7 +79,7 @@ def _room_slam():
 
     slam = EKFLineSLAM(initial_pose=(2.0, 1.5, 0.3))
     r, a = cast(ROOM, (2.0, 1.5, 0.3))
-    slam.step(r, a, (2.0, 1.5, 0.3), max_range=8.0)
+    slam.step(Scan(r, a, 8.0), (2.0, 1.5, 0.3))
     return slam, cast, ROOM
 
 
@@ -115,7 +116,7 @@ def test_edge_on_landmark_and_line_through_the_robot_give_no_nan():
     slam.update([through], np.array([[-1.0, 0.0], [1.0, 1e-6]]))
     for k in range(5):
         r, a = cast(room, (2.0 + 0.05 * k, 1.5, 0.3), seed=k)
-        slam.step(r, a, (2.0 + 0.05 * k, 1.5, 0.3), max_range=8.0)
+        slam.step(Scan(r, a, 8.0), (2.0 + 0.05 * k, 1.5, 0.3))
     assert np.all(np.isfinite(slam.ekf.x)) and np.all(np.isfinite(slam.ekf.P))
     assert np.hypot(*(slam.pose[:2] - [2.2, 1.5])) < 0.02
 
@@ -123,8 +124,8 @@ def test_edge_on_landmark_and_line_through_the_robot_give_no_nan():
 @pytest.mark.parametrize("world", ["random:101", "random:106", "random:109", "random:118"])
 def test_ekf_halves_the_odometry_error_on_held_out_worlds(world):
     from fhslam.metrics import ate
+    from fhslam.pipeline import run_slam
     from fhslam.sim import OdometryNoise, load_world, simulate
-    from fhslam.slam import run_slam
 
     log = simulate(load_world(world), seed=0, odometry=OdometryNoise.drifting(), laps=3)
     r = run_slam(log, "ekf")
@@ -136,8 +137,8 @@ def test_landmarks_through_the_origin_keep_their_extent():
     """The paper world's walls x = 0 and y = 0 pass through the world origin (r ≈ 0), where a
     landmark flips between (α, r) and (α + π, −r): its seen extent must not flip with it."""
     from fhslam.metrics import map_error
+    from fhslam.pipeline import run_slam
     from fhslam.sim import OdometryNoise, paper_world, simulate
-    from fhslam.slam import run_slam
 
     log = simulate(paper_world(), seed=2, odometry=OdometryNoise.drifting(), max_scans=250)
     r = run_slam(log, "ekf")

@@ -37,7 +37,7 @@ def same_arithmetic() -> bool:
 
 @pytest.fixture(scope="module")
 def computed() -> dict[str, np.ndarray]:
-    return make_golden.cases(make_golden.OldAPI(), data_dir())
+    return make_golden.cases(make_golden.API(), data_dir())
 
 
 @pytest.mark.parametrize("case", CASES)

@@ -5,10 +5,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from fhslam.graphslam import GraphFastHoughSLAM, GraphSlamParams
 from fhslam.metrics import ate
+from fhslam.pipeline import run_backend, run_slam
 from fhslam.sim import OdometryNoise, degrade, load_world, simulate
-from fhslam.slam import run_slam
+from fhslam.slam import GraphFastHoughSLAM, GraphSlamParams
 
 
 @pytest.fixture(scope="module")
@@ -20,7 +20,7 @@ def three_laps():
 def test_loops_are_closed_and_the_drift_removed(three_laps):
     log = three_laps
     slam = GraphFastHoughSLAM()
-    r = slam.run(log)
+    r = run_backend(slam, log)
     assert len(slam.loops) >= 20  # measured 105
     assert all(lc.score >= slam.params.loop_min_score for lc in slam.loops)
     assert all(lc.new - lc.old >= slam.params.loop_min_gap for lc in slam.loops)
@@ -46,7 +46,7 @@ def test_dropped_scans_and_clutter(three_laps):
 
 def test_without_loop_closures_no_loop_edges(three_laps):
     slam = GraphFastHoughSLAM(GraphSlamParams(loop_candidates=0))
-    slam.run(three_laps)
+    run_backend(slam, three_laps)
     assert slam.loops == [] and set(slam.graph.edges[3]) == {"odometry"}
 
 
@@ -68,7 +68,7 @@ def test_bad_parameters_are_named(field, value, message):
 
 
 def _relations_error(real_data, name):
-    from fhslam.data import load_log
+    from fhslam.datasets import load_log
     from fhslam.io import read_relations
     from fhslam.metrics import relations_error
 

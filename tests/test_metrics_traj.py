@@ -19,15 +19,13 @@ from fhslam.metrics import (
     error_stats,
     map_coverage,
     map_error,
-    observed_wall_points,
     rpe,
     rpe_errors,
     rpe_pairs,
     rpe_rot_deg,
     sample_segments,
-    visible_wall_points,
 )
-from fhslam.sim import paper_world, simulate
+from fhslam.sim import observed_wall_points, paper_world, simulate, visible_wall_points
 
 
 def trajectory(n: int = 60, seed: int = 0) -> np.ndarray:

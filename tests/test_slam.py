@@ -7,9 +7,12 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from fhslam.calibration import calibrate_pose
 from fhslam.geometry import compose, inverse, wrap_angle
 from fhslam.lines import line_from_points
-from fhslam.slam import FastHoughSLAM, calibrate_pose, run_slam
+from fhslam.pipeline import run_slam
+from fhslam.scan import Scan
+from fhslam.slam import FastHoughSLAM
 
 
 def seg(x0, y0, x1, y1, n=40):
@@ -65,9 +68,9 @@ def test_no_pairs_keeps_the_prediction():
 
 def test_dropped_scans_and_empty_scans_keep_odometry():
     slam = FastHoughSLAM(initial_pose=(0, 0, 0))
-    r = slam.step(None, None, (0, 0, 0))
+    r = slam.step(None, (0, 0, 0))
     assert r.n_lines == 0 and not r.corrected
-    r = slam.step(np.full(181, np.nan), np.radians(np.arange(-90, 91.0)), (1.0, 0.5, 0.1))
+    r = slam.step(Scan(np.full(181, np.nan), np.radians(np.arange(-90, 91.0))), (1.0, 0.5, 0.1))
     np.testing.assert_allclose(r.pose, [1.0, 0.5, 0.1])
     assert r.n_lines == 0 and slam.references == []
 
@@ -90,8 +93,8 @@ HELD_OUT = ("random:101", "random:106", "random:109", "random:118")
 
 
 def _run(name, laps, degraded=False):
-    from fhslam.metrics import ate, map_coverage, map_error, observed_wall_points
-    from fhslam.sim import OdometryNoise, degrade, load_world, simulate
+    from fhslam.metrics import ate, map_coverage, map_error
+    from fhslam.sim import OdometryNoise, degrade, load_world, observed_wall_points, simulate
 
     log = simulate(load_world(name), seed=0, odometry=OdometryNoise.drifting(), laps=laps)
     if degraded:

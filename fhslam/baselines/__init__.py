@@ -2,7 +2,8 @@
 
 Line extractors share the call shape of the main extractor: ``f(points, params=None,
 pose=None)`` returning a list of :class:`fhslam.lines.Line` whose ``inliers`` index
-``points``. :class:`EKFLineSLAM` is the EKF line-SLAM baseline (filterpy).
+``points``. The SLAM baselines (EKF line SLAM, odometry) are back ends in
+:mod:`fhslam.slam`.
 """
 
 from fhslam.baselines.classical import (
@@ -13,13 +14,10 @@ from fhslam.baselines.classical import (
     hough_opencv_probabilistic,
     hough_opencv_raster,
 )
-from fhslam.baselines.ekf_slam import EKFLineSLAM, EKFParams
 from fhslam.baselines.split_merge import SplitMergeParams, split_and_merge
 
 __all__ = [
     "ClassicalHoughParams",
-    "EKFLineSLAM",
-    "EKFParams",
     "SplitMergeParams",
     "hough_accumulator",
     "hough_numpy_accumulator",

@@ -1,8 +1,10 @@
 """Reading and writing logs, trajectories and maps: CARMEN logs, trajectory files, map JSON,
-benchmark relations files."""
+benchmark relations files. Every reader reports bad input as a
+:class:`fhslam.errors.InputError` naming the file (and line); every writer writes atomically
+(:mod:`fhslam.io.files`)."""
 
 from fhslam.io.carmen import CarmenFormatError, flaser_angles, read_carmen, write_carmen
-from fhslam.io.log import Log
+from fhslam.io.log import Log, effective_max_range, no_return_reading
 from fhslam.io.mapfile import MapFormatError, lines_from_segments, read_map, write_map
 from fhslam.io.relations import RelationsFormatError, read_relations
 from fhslam.io.rosbag import BagFormatError, is_bag, read_bag
@@ -15,9 +17,11 @@ __all__ = [
     "MapFormatError",
     "RelationsFormatError",
     "TrajectoryFormatError",
+    "effective_max_range",
     "flaser_angles",
     "is_bag",
     "lines_from_segments",
+    "no_return_reading",
     "read_bag",
     "read_carmen",
     "read_map",

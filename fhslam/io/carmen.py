@@ -21,14 +21,14 @@ Formats (CARMEN logger documentation; see ``data/SOURCES.md``)::
 
 from __future__ import annotations
 
-import errno
 from os import PathLike
-from pathlib import Path
 
 import numpy as np
 from numpy.typing import NDArray
 
+from fhslam.errors import InputError
 from fhslam.geometry import relative, wrap_angle
+from fhslam.io.files import atomic_output, input_path, reading
 from fhslam.io.log import Log, effective_max_range, is_number
 
 HOSTNAME = "fhslam"
@@ -36,7 +36,7 @@ FLASER_MAX_RANGE = 80.0
 """CARMEN's assumed maximum range of an old ``FLASER`` laser, metres."""
 
 
-class CarmenFormatError(ValueError):
+class CarmenFormatError(InputError):
     """A malformed CARMEN log. The message reads ``"{path}:{lineno}: {what is wrong}"``."""
 
 
@@ -126,7 +126,7 @@ def write_carmen(log: Log, path: str | PathLike[str]) -> None:
         "ipc_timestamp ipc_hostname logger_timestamp",
         f"# {laser} poses are odometry; no ground truth is stored in this file",
     ]
-    with Path(path).open("w", encoding="utf-8") as f:
+    with atomic_output(path) as f:
         f.write("\n".join(header) + "\n")
         for k in range(len(log)):
             ts = repr(float(log.timestamps[k]))
@@ -269,22 +269,20 @@ def read_carmen(path: str | PathLike[str], max_range: float | None = None) -> Lo
 
     Raises
     ------
-    FileNotFoundError
+    MissingInputError
         If ``path`` does not exist.
     CarmenFormatError
         ``"{path}:{lineno}: ..."`` for a malformed laser line (truncated, non-numeric field,
         wrong reading count, non-finite pose), a beam count differing from the first scan's,
         or a file with no laser messages or with both FLASER and ROBOTLASER1.
     """
-    path = Path(path)
-    if not path.is_file():
-        raise FileNotFoundError(errno.ENOENT, "CARMEN log not found", str(path))
+    path = input_path(path, "CARMEN log")
     stamps: list[float] = []
     ranges: list[NDArray] = []
     odometry: list[NDArray] = []
     first: tuple[str, int, int, NDArray | None] | None = None  # kind, lineno, n, geometry
     try:
-        with path.open(encoding="utf-8") as f:
+        with reading(path), path.open(encoding="utf-8") as f:
             for lineno, line in enumerate(f, start=1):
                 fields = line.split()
                 if not fields or fields[0].startswith("#") or fields[0] not in _PARSERS:

@@ -7,16 +7,16 @@ the same on simulated and real data.
 
 from __future__ import annotations
 
-import errno
 from collections.abc import Callable
 from dataclasses import dataclass
 from os import PathLike
-from pathlib import Path
 from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from fhslam.errors import InputError
+from fhslam.io.files import input_path, reading
 from fhslam.scan import Scan
 
 
@@ -210,7 +210,7 @@ def is_number(token: str) -> bool:
 def read_numeric_table(
     path: str | PathLike[str],
     columns: str,
-    error: type[ValueError],
+    error: type[InputError],
     what: str,
     check: Callable[[list[float], str], None] | None = None,
 ) -> NDArray[np.float64]:
@@ -222,7 +222,7 @@ def read_numeric_table(
     columns : str
         The expected fields, e.g. ``"timestamp x y theta"``; each row must have as many.
     error : type
-        The :class:`ValueError` subclass to raise, with ``"{path}:{lineno}: ..."``.
+        The :class:`~fhslam.errors.InputError` subclass to raise, with ``"{path}:{lineno}: ..."``.
     what : str
         What a row is, for the message of an empty file (e.g. ``"poses"``).
     check : callable, optional
@@ -232,13 +232,11 @@ def read_numeric_table(
     -------
     ndarray, shape (R, len(columns.split()))
     """
-    path = Path(path)
-    if not path.is_file():
-        raise FileNotFoundError(errno.ENOENT, f"{what} file not found", str(path))
+    path = input_path(path)
     n = len(columns.split())
     rows: list[list[float]] = []
     try:
-        with path.open(encoding="utf-8") as f:
+        with reading(path), path.open(encoding="utf-8") as f:
             for lineno, line in enumerate(f, start=1):
                 fields = line.split()
                 if not fields or fields[0].startswith("#"):

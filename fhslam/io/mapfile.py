@@ -12,24 +12,24 @@ round-trip ``repr`` (what :mod:`json` does), so a map reads back exactly.
 
 from __future__ import annotations
 
-import errno
 import json
 import math
 from collections.abc import Sequence
 from os import PathLike
-from pathlib import Path
 from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike
 
+from fhslam.errors import InputError
 from fhslam.geometry import line_through
+from fhslam.io.files import atomic_output, input_path, reading
 from fhslam.lines import Line
 
 _KEYS = ("sp", "ep", "rho", "theta", "n")
 
 
-class MapFormatError(ValueError):
+class MapFormatError(InputError):
     """A malformed map file. The message names the file and, where it applies, the line index
     (``"{path}: lines[3]: ..."``) or the JSON text line (``"{path}:12: not valid JSON ..."``).
     """
@@ -71,7 +71,8 @@ def write_map(path: str | PathLike[str], lines: Sequence[Line]) -> None:
     entries = [json.dumps(_entry(line, i)) for i, line in enumerate(lines)]
     body = ",\n  ".join(entries)
     text = '{"lines": [\n  ' + body + "\n]}\n" if entries else '{"lines": []}\n'
-    Path(path).write_text(text, encoding="utf-8")
+    with atomic_output(path) as f:
+        f.write(text)
 
 
 def _number(value: Any, what: str, where: str) -> float:
@@ -129,7 +130,7 @@ def read_map(path: str | PathLike[str]) -> list[Line]:
 
     Raises
     ------
-    FileNotFoundError
+    MissingInputError
         If ``path`` does not exist.
     MapFormatError
         If the file is not JSON (naming the text line), has no ``"lines"`` list, or a line
@@ -137,12 +138,12 @@ def read_map(path: str | PathLike[str]) -> list[Line]:
         or a non-integer ``n`` (naming the index, ``lines[i]``). A ``theta`` outside
         [0, 2 pi) is wrapped into it.
     """
-    path = Path(path)
-    if not path.is_file():
-        raise FileNotFoundError(errno.ENOENT, "map file not found", str(path))
+    path = input_path(path, "map")
     try:
         # json accepts NaN/Infinity; reject them as non-finite numbers below.
-        data = json.loads(path.read_text(encoding="utf-8"))
+        with reading(path):
+            text = path.read_text(encoding="utf-8")
+        data = json.loads(text)
     except json.JSONDecodeError as e:
         raise MapFormatError(f"{path}:{e.lineno}: not valid JSON ({e.msg})") from None
     except UnicodeDecodeError as e:

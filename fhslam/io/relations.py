@@ -17,6 +17,7 @@ from os import PathLike
 import numpy as np
 from numpy.typing import NDArray
 
+from fhslam.errors import InputError
 from fhslam.io.log import read_numeric_table
 
 PLANAR_TOL = 1e-6
@@ -25,7 +26,7 @@ PLANAR_TOL = 1e-6
 _FIELDS = "timestamp1 timestamp2 x y z roll pitch yaw"
 
 
-class RelationsFormatError(ValueError):
+class RelationsFormatError(InputError):
     """A malformed relations file. The message reads ``"{path}:{lineno}: {what is wrong}"``."""
 
 
@@ -49,7 +50,7 @@ def read_relations(
 
     Raises
     ------
-    FileNotFoundError
+    MissingInputError
         If ``path`` does not exist.
     RelationsFormatError
         ``"{path}:{lineno}: ..."`` for a line without exactly 8 fields, a non-numeric or

@@ -30,15 +30,17 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import NDArray
 
+from fhslam.errors import InputError
 from fhslam.geometry import wrap_angle
 from fhslam.io.carmen import flaser_angles
+from fhslam.io.files import input_path
 from fhslam.io.log import Log, effective_max_range
 
 SCAN_TYPE = "sensor_msgs/msg/LaserScan"
 ODOM_TYPE = "nav_msgs/msg/Odometry"
 
 
-class BagFormatError(ValueError):
+class BagFormatError(InputError):
     """A bag that cannot be read as a laser log (names the file and the topic)."""
 
 
@@ -115,7 +117,7 @@ def read_bag(
         raise ValueError(f"beams must be 'carmen' or 'bag', got {beams!r}")
     p = Path(path)
     if not p.exists():
-        raise FileNotFoundError(2, "No such file or directory", str(p))
+        input_path(p, "bag")  # raises MissingInputError
     try:
         reader = AnyReader([p], default_typestore=get_typestore(Stores.ROS1_NOETIC))
         reader.open()

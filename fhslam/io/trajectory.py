@@ -8,15 +8,16 @@ from __future__ import annotations
 
 from collections.abc import Iterable
 from os import PathLike
-from pathlib import Path
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from fhslam.errors import InputError
+from fhslam.io.files import atomic_output
 from fhslam.io.log import read_numeric_table
 
 
-class TrajectoryFormatError(ValueError):
+class TrajectoryFormatError(InputError):
     """A malformed trajectory file. The message reads ``"{path}:{lineno}: {what is wrong}"``."""
 
 
@@ -55,7 +56,7 @@ def write_trajectory(
     else:
         comments = [c for h in header for c in str(h).splitlines()]
     rows = np.column_stack([t, p]).tolist()
-    with Path(path).open("w", encoding="utf-8") as f:
+    with atomic_output(path) as f:
         for c in comments:
             f.write(f"# {c}\n")
         for row in rows:
@@ -72,7 +73,7 @@ def read_trajectory(path: str | PathLike[str]) -> tuple[NDArray[np.float64], NDA
 
     Raises
     ------
-    FileNotFoundError
+    MissingInputError
         If ``path`` does not exist.
     TrajectoryFormatError
         ``"{path}:{lineno}: ..."`` for a line without exactly 4 fields, a non-numeric or

@@ -1,10 +1,18 @@
-"""Simulation: polygonal worlds, a ray-casting laser, drifting odometry, `simulate()`, and
-`degrade()` (dropped scans, clutter returns)."""
+"""Simulation: polygonal worlds, a ray-casting laser, drifting odometry, `simulate()`,
+`degrade()` (dropped scans, clutter returns), and the ground truth the metrics score against
+(true lines of a scan, wall points the laser hit)."""
 
 from fhslam.sim.degrade import degrade
 from fhslam.sim.laser import LaserParams, add_range_noise, beam_angles, cast_rays
 from fhslam.sim.odometry import OdometryNoise, odometry_from_truth
 from fhslam.sim.simulate import MotionParams, follow_route, is_closed_route, lap_route, simulate
+from fhslam.sim.truth import (
+    TrueLine,
+    beam_wall_points,
+    observed_wall_points,
+    true_lines,
+    visible_wall_points,
+)
 from fhslam.sim.world import (
     World,
     WorldFormatError,
@@ -18,19 +26,24 @@ __all__ = [
     "LaserParams",
     "MotionParams",
     "OdometryNoise",
+    "TrueLine",
     "World",
     "WorldFormatError",
     "add_range_noise",
     "beam_angles",
+    "beam_wall_points",
     "cast_rays",
     "degrade",
     "follow_route",
     "is_closed_route",
     "lap_route",
     "load_world",
+    "observed_wall_points",
     "odometry_from_truth",
     "paper_world",
     "random_world",
     "route_clearance",
     "simulate",
+    "true_lines",
+    "visible_wall_points",
 ]

@@ -12,7 +12,6 @@ and ``"random:SEED"`` (:func:`random_world`, held-out worlds nothing was tuned o
 
 from __future__ import annotations
 
-import errno
 import json
 from dataclasses import dataclass
 from os import PathLike
@@ -22,12 +21,14 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from fhslam.errors import InputError
 from fhslam.geometry import segment_distances, transform_points
+from fhslam.io.files import input_path, reading
 
 BUILTIN_WORLDS = ("paper", "random:SEED")
 
 
-class WorldFormatError(ValueError):
+class WorldFormatError(InputError):
     """A world definition (dict or JSON file) that is malformed; the message names the field."""
 
 
@@ -334,9 +335,9 @@ def load_world(name_or_path: str | PathLike[str]) -> World:
 
     Raises
     ------
-    ValueError
+    InputError
         For an unknown built-in name (the message lists the built-ins).
-    FileNotFoundError
+    MissingInputError
         For a path (ends in ``.json`` or contains a directory separator) that does not exist.
     WorldFormatError
         For a file that is not valid JSON or has a malformed field; names the file and field.
@@ -348,20 +349,22 @@ def load_world(name_or_path: str | PathLike[str]) -> World:
         if text.startswith("random:"):
             seed = text.removeprefix("random:")
             if not seed.isdigit():
-                raise ValueError(
+                raise InputError(
                     f"world {text!r}: the seed after 'random:' must be a non-negative integer"
                 )
             return random_world(int(seed))
     path = Path(name_or_path)
     if not path.is_file():
         if isinstance(name_or_path, PathLike) or path.suffix or len(path.parts) > 1:
-            raise FileNotFoundError(errno.ENOENT, "world file not found", str(path))
-        raise ValueError(
+            input_path(path, "world")  # raises
+        raise InputError(
             f"unknown world {text!r}: built-in worlds are {', '.join(BUILTIN_WORLDS)}; "
             "or give the path of a world JSON file"
         )
     try:
-        data = json.loads(path.read_text(encoding="utf-8"))
+        with reading(path):
+            text = path.read_text(encoding="utf-8")
+        data = json.loads(text)
     except (json.JSONDecodeError, UnicodeDecodeError) as e:
         raise WorldFormatError(f"{path}: not valid JSON ({e})") from None
     return World.from_dict(data, source=str(path))

@@ -1,7 +1,7 @@
 """FH-SLAM on a pose graph: the paper's method made to survive long real logs.
 
 On a simulated world the paper's step-by-step calibration keeps the pose within centimetres
-(:mod:`fhslam.slam`). On the Intel Research Lab log (45 minutes, 600 m, the same rooms
+(:mod:`fhslam.slam.fht`). On the Intel Research Lab log (45 minutes, 600 m, the same rooms
 visited again and again) it drifts by metres: every reference line is placed with the pose
 of its time, and nothing ever corrects a line placed wrongly, so the errors stay in the map
 and feed back into the pose. What the real logs need, and this module adds:
@@ -32,26 +32,25 @@ end sees it. This rescues MIT CSAIL (whose odometry heading is poor: 1.40 m → 
 relation error) but derails Intel at an odometry glitch (0.041 m → 2.1 m), so it is off by
 default: an open problem, shown in notebook 08.
 
-``method="graph"`` in :func:`fhslam.slam.run_slam` and ``fhslam slam --method graph`` run it;
+``method="graph"`` in :func:`fhslam.pipeline.run_slam` and ``fhslam slam --method graph`` run it;
 ``method="fht"`` stays the paper's procedure.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
-from tqdm.auto import tqdm
 
-from fhslam.geometry import as_pose, compose, relative, signed_distance, transform_points
-from fhslam.io.log import scan_of
+from fhslam.geometry import as_pose, compose, relative, transform_points
 from fhslam.lines import Line, transform_lines
-from fhslam.matching import match_lines, merge
 from fhslam.posegraph import PoseGraph
-from fhslam.scan import scan_to_points
+from fhslam.reference_map import ReferenceMap
+from fhslam.scan import Scan
 from fhslam.scanmatch import match_clouds, voxel_downsample
-from fhslam.slam import FastHoughSLAM, SlamParams, SlamResult, StepResult
+from fhslam.slam.base import FinalEstimate, StepResult
+from fhslam.slam.fht import FastHoughSLAM, SlamParams
 
 __all__ = ["GraphFastHoughSLAM", "GraphSlamParams", "LoopClosure"]
 
@@ -196,7 +195,6 @@ class GraphFastHoughSLAM:
         self._odometry_edge: list[int] = [-1]  # per keyframe: the edge from its predecessor
         self._scan_kf: list[int] = []
         self._scan_rel: list[NDArray[np.float64]] = []
-        self._steps: list[StepResult] = []
         self._last_odometry: NDArray[np.float64] | None = None
         self._corrected: NDArray[np.float64] | None = None
 
@@ -272,22 +270,13 @@ class GraphFastHoughSLAM:
             self.graph.optimize(p.optimize_iterations, p.optimize_tol)
 
     # -- the per-scan step -----------------------------------------------------------------
-    def step(
-        self,
-        ranges: ArrayLike | None,
-        angles: ArrayLike | None,
-        odometry: ArrayLike,
-        max_range: float | None = None,
-    ) -> StepResult:
+    def step(self, scan: Scan | None, odometry: ArrayLike) -> StepResult:
         """Run the front end on one scan, start a keyframe when due, attach the scan to it;
         returns the front end's step (its pose in the front end's frame)."""
         p = self.params
         odometry = as_pose(odometry, "odometry")
-        pts = None
-        if ranges is not None:
-            cap = p.cloud_max_range if max_range is None else min(max_range, p.cloud_max_range)
-            pts, _ = scan_to_points(ranges, angles, max_range=cap)
-        res = self.front_end.step(ranges, angles, self._matched_odometry(odometry, pts), max_range)
+        pts = None if scan is None else scan.points(max_range=p.cloud_max_range)[0]
+        res = self.front_end.step(scan, self._matched_odometry(odometry, pts))
         pose = res.pose
         if not self._kf_front or self._keyframe_due(pose):
             self._new_keyframe(pose, res.lines)
@@ -298,7 +287,6 @@ class GraphFastHoughSLAM:
         if pts is not None and len(pts):
             cloud = np.vstack([self._clouds[k], transform_points(rel, pts)])
             self._clouds[k] = voxel_downsample(cloud, p.cloud_voxel)
-        self._steps.append(res)
         return res
 
     def _matched_odometry(
@@ -361,42 +349,25 @@ class GraphFastHoughSLAM:
             return np.zeros((0, 3))
         return compose(self.graph.poses[np.array(self._scan_kf)], np.array(self._scan_rel))
 
-    def finish(self) -> None:
-        """Close the last keyframe (refine its edge, look for loops) and optimise."""
+    def finish(self) -> FinalEstimate:
+        """Close the last keyframe (refine its edge, look for loops), optimise, and build the
+        map from the keyframes at their optimised poses; every scan's pose is revised."""
         n = len(self.graph)
         if n >= 2:
             self._refine_odometry_edge(n - 1)
             self._close_loops(n - 1)
-        if n >= 2:
             self.graph.optimize(self.params.optimize_iterations, self.params.optimize_tol)
+        return FinalEstimate(self.build_map(), self.poses)
 
     def build_map(self) -> list[Line]:
         """The map of reference lines from the keyframes' lines at their optimised poses
-        (Loop 2: match, merge into the matched reference line, add long new lines)."""
+        (:meth:`fhslam.reference_map.ReferenceMap.update`: the front end's policy, applied
+        keyframe by keyframe)."""
         fe = self.params.front_end
-        refs: list[Line] = []
+        refs = ReferenceMap(
+            fe.matching, fe.min_reference_length, fe.min_reference_points, fe.max_merge_residual
+        )
         for x, lines in zip(self.graph.poses, self._kf_lines, strict=True):
             world = transform_lines(lines, x)
-            match = match_lines(world, refs, fe.matching, x) if refs else np.full(len(world), -1)
-            for ln, j in zip(world, match, strict=True):
-                if j >= 0:
-                    ref = refs[j]
-                    off = np.abs(signed_distance(np.array([ln.sp, ln.ep]), ref.rho, ref.theta))
-                    if off.max() <= fe.max_merge_residual:
-                        refs[j] = merge(ref, ln)
-                elif ln.length >= fe.min_reference_length and ln.n >= fe.min_reference_points:
-                    refs.append(ln)
-        return refs
-
-    def run(self, log, progress: bool = False) -> SlamResult:
-        """Run over a whole log (as :meth:`fhslam.slam.FastHoughSLAM.run`)."""
-        n = len(log.timestamps)
-        for k in tqdm(
-            range(n), desc=f"FH-SLAM graph {getattr(log, 'name', '')}", unit="scan",
-            disable=not progress,
-        ):  # fmt: skip
-            self.step(*scan_of(log, k), log.odometry[k], log.max_range)
-        self.finish()
-        poses = self.poses
-        steps = [replace(s, pose=q) for s, q in zip(self._steps, poses, strict=True)]
-        return SlamResult(np.asarray(log.timestamps, dtype=float), poses, self.build_map(), steps)
+            refs.update(world, refs.associate(world, x))
+        return refs.lines

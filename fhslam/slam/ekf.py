@@ -24,7 +24,6 @@ from dataclasses import dataclass, field
 import numpy as np
 from filterpy.kalman import ExtendedKalmanFilter
 from numpy.typing import ArrayLike, NDArray
-from tqdm.auto import tqdm
 
 from fhslam.extraction import ExtractionParams, extract_lines
 from fhslam.geometry import (
@@ -35,9 +34,19 @@ from fhslam.geometry import (
     relative,
     wrap_angle,
 )
-from fhslam.io.log import scan_of
 from fhslam.lines import Line
-from fhslam.scan import scan_to_points
+from fhslam.scan import Scan
+from fhslam.slam.base import FinalEstimate, StepResult
+
+__all__ = [
+    "CHI2_2DOF_99",
+    "EKFLineSLAM",
+    "EKFParams",
+    "line_covariance",
+    "measurement_jacobian",
+    "predict_measurement",
+    "residual",
+]
 
 CHI2_2DOF_99 = 9.2103
 """99 % quantile of the χ² distribution with 2 degrees of freedom."""
@@ -334,16 +343,15 @@ class EKFLineSLAM:
         self._ends[j] = pts[[int(np.argmin(t)), int(np.argmax(t))]]
         self._support[j] += ln.n
 
-    def step(self, ranges, angles, odometry, max_range=None) -> tuple[int, int]:
-        """Predict from odometry and, if there is a scan, update; returns (matched, added)."""
+    def step(self, scan: Scan | None, odometry: ArrayLike) -> StepResult:
+        """Predict from odometry and, if there is a scan, update (``scan=None``: dropped)."""
         self.predict(odometry)
-        if ranges is None:
-            return 0, 0
-        points, _ = scan_to_points(ranges, angles, max_range=max_range)
+        if scan is None:
+            return StepResult(self.pose, 0, 0, 0, False)
+        points, _ = scan.points()
         lines = extract_lines(points, self.params.extraction)
-        if not lines:
-            return 0, 0
-        return self.update(lines, points)
+        matched, added = self.update(lines, points) if lines else (0, 0)
+        return StepResult(self.pose, len(lines), matched, added, matched > 0, lines)
 
     def landmarks(self) -> list[Line]:
         """The map: each landmark line over the extent it was seen."""
@@ -358,12 +366,6 @@ class EKFLineSLAM:
             )  # fmt: skip
         return out
 
-    def run(self, log, progress: bool = False):
-        """Run over a whole log; returns a :class:`fhslam.slam.SlamResult`."""
-        from fhslam.slam import SlamResult
-
-        poses = []
-        for k in tqdm(range(len(log.timestamps)), desc="EKF", unit="scan", disable=not progress):
-            self.step(*scan_of(log, k), log.odometry[k], log.max_range)
-            poses.append(self.pose)
-        return SlamResult(np.asarray(log.timestamps, float), np.array(poses), self.landmarks(), [])
+    def finish(self) -> FinalEstimate:
+        """The map (:meth:`landmarks`); the filter's poses at each step stand."""
+        return FinalEstimate(self.landmarks())

@@ -28,9 +28,9 @@ from fhslam.baselines import (
 )
 from fhslam.extraction import extract_lines
 from fhslam.lines import Line
-from fhslam.metrics import detection_scores, true_lines
+from fhslam.metrics import detection_scores
 from fhslam.scan import scan_to_points
-from fhslam.sim import load_world, simulate
+from fhslam.sim import load_world, simulate, true_lines
 
 HELD_OUT_WORLDS = ("random:101", "random:102", "random:103", "random:104")
 """Worlds for evaluation; the extraction parameters were tuned on the paper world only."""
@@ -132,7 +132,7 @@ def run_slam_bench(world: str = "paper", seed: int = 0, repeats: int = 3) -> lis
     """SLAM steps per second of FH-SLAM, FH-SLAM on a pose graph, FH-SLAM with the classical
     Hough extractor and the EKF baseline on one simulated run (median wall time over
     ``repeats`` runs, one process)."""
-    from fhslam.slam import run_slam
+    from fhslam.pipeline import run_slam
 
     log = simulate(load_world(world), seed=seed)
     rows = []

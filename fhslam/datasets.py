@@ -29,6 +29,9 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Literal
 
+from fhslam.errors import InputError, MissingInputError
+from fhslam.io import Log, is_bag, read_bag, read_carmen
+
 __all__ = [
     "DATASETS",
     "ENV_VAR",
@@ -56,7 +59,7 @@ Kind = Literal["log", "relations"]
 KINDS: tuple[str, ...] = ("log", "relations")
 
 
-class DatasetNotFoundError(FileNotFoundError):
+class DatasetNotFoundError(MissingInputError):
     """No copy of a dataset file was found (and no download was asked for)."""
 
 
@@ -207,7 +210,7 @@ def _dataset(name: str) -> Dataset:
     try:
         return DATASETS[name]
     except KeyError:
-        raise ValueError(f"unknown dataset {name!r}; known datasets: {_known()}") from None
+        raise InputError(f"unknown dataset {name!r}; known datasets: {_known()}") from None
 
 
 def is_held_out(name: str) -> bool:
@@ -259,9 +262,9 @@ def find_dataset(
     kind then overrides ``kind``). The places looked in are in the module docstring; nothing
     is downloaded unless ``download=True``.
 
-    Raises :class:`DatasetNotFoundError` (a ``FileNotFoundError``) listing every place looked
-    at, ``ValueError`` for an unknown name or kind, for a dataset without that file, and for a
-    local copy whose size is not the recorded one.
+    Raises :class:`DatasetNotFoundError` (a :class:`~fhslam.errors.MissingInputError`) listing
+    every place looked at, :class:`~fhslam.errors.InputError` for an unknown name and for a
+    local copy whose size is not the recorded one, ``ValueError`` for an unknown kind.
     """
     if kind not in KINDS:
         raise ValueError(f"kind must be one of {KINDS}, not {kind!r}")
@@ -276,7 +279,7 @@ def find_dataset(
     elif _looks_like_path(name_or_path):
         raise DatasetNotFoundError(f"{text}: no such file (and not a dataset name: {_known()})")
     else:
-        raise ValueError(f"unknown dataset {text!r}; known datasets: {_known()}")
+        raise InputError(f"unknown dataset {text!r}; known datasets: {_known()}")
     f = ds.file(kind)
 
     looked: list[str] = []
@@ -310,7 +313,7 @@ def _check_size(path: Path, f: DataFile) -> None:
     size = path.stat().st_size
     if size != f.size:
         hint = " (a Git LFS pointer, not the data?)" if size < 1024 else ""
-        raise ValueError(
+        raise InputError(
             f"{path}: {size} bytes, but {f.name} has {f.size} bytes{hint}; "
             f"replace it with the file from {f.url}"
         )
@@ -327,8 +330,8 @@ def _sha256(path: Path) -> str:
 def verify(name: str, download: bool = False) -> dict[str, Path]:
     """Find every file of dataset ``name`` and check its sha256; ``{kind: path}``.
 
-    Raises ``ValueError`` naming the file whose hash is not the recorded one, and
-    :class:`DatasetNotFoundError` as :func:`find_dataset` does.
+    Raises :class:`~fhslam.errors.InputError` naming the file whose hash is not the recorded
+    one, and :class:`DatasetNotFoundError` as :func:`find_dataset` does.
     """
     ds = _dataset(name)
     found: dict[str, Path] = {}
@@ -336,7 +339,7 @@ def verify(name: str, download: bool = False) -> dict[str, Path]:
         path = find_dataset(name, kind=kind, download=download)
         digest = _sha256(path)
         if digest != f.sha256:
-            raise ValueError(f"{path}: sha256 {digest}, but {f.name} has sha256 {f.sha256}")
+            raise InputError(f"{path}: sha256 {digest}, but {f.name} has sha256 {f.sha256}")
         found[kind] = path
     return found
 
@@ -346,20 +349,23 @@ def load_log(
     scan_topic: str | None = None,
     odom_topic: str | None = None,
     download: bool = False,
-):
+    max_range: float | None = None,
+) -> Log:
     """A :class:`fhslam.io.Log` from a CARMEN file, a ROS bag, or a dataset name.
+
+    ``max_range`` (metres) overrides the laser's maximum range found in the file (see
+    :func:`fhslam.io.read_carmen` and :func:`fhslam.io.read_bag`): readings at or beyond it
+    are no returns.
 
     Examples
     --------
     >>> log = load_log("intel")     # the bag found by :func:`find_dataset`  # doctest: +SKIP
     """
-    from fhslam.io import is_bag, read_bag, read_carmen
-
     path = Path(source)
     if not path.exists() and str(source) in DATASETS:
         path = find_dataset(str(source), "log", download=download)
     if is_bag(path):
-        return read_bag(path, scan_topic=scan_topic, odom_topic=odom_topic)
+        return read_bag(path, scan_topic=scan_topic, odom_topic=odom_topic, max_range=max_range)
     if scan_topic or odom_topic:
-        raise ValueError(f"{path}: --scan-topic/--odom-topic apply to ROS bags only")
-    return read_carmen(path)
+        raise InputError(f"{path}: --scan-topic/--odom-topic apply to ROS bags only")
+    return read_carmen(path, max_range=max_range)

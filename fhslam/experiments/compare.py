@@ -17,8 +17,8 @@ from joblib import Parallel, delayed
 from tqdm.auto import tqdm
 
 from fhslam.metrics import ate, map_error
+from fhslam.pipeline import METHODS, run_slam
 from fhslam.sim import OdometryNoise, load_world, simulate
-from fhslam.slam import METHODS, run_slam
 
 
 def noise_levels() -> dict[str, OdometryNoise]:
@@ -79,7 +79,7 @@ def slam_sweep(
     world: str = "paper",
     seeds: Sequence[int] = range(20),
     levels: Sequence[str] = ("low", "medium", "high"),
-    methods: Sequence[str] = METHODS,
+    methods: Sequence[str] = tuple(METHODS),
     n_jobs: int = -1,
     progress: bool = True,
 ) -> list[RunResult]:
@@ -98,7 +98,7 @@ def slam_sweep(
     """
     unknown = set(methods) - set(METHODS)
     if unknown:
-        raise ValueError(f"unknown SLAM methods {sorted(unknown)}; choose from {METHODS}")
+        raise ValueError(f"unknown SLAM methods {sorted(unknown)}; choose from {list(METHODS)}")
     jobs = [(lv, s) for lv in levels for s in seeds]
     par = Parallel(n_jobs=n_jobs, return_as="generator")
     results = par(delayed(one_run)(world, lv, s, tuple(methods)) for lv, s in jobs)

@@ -1,0 +1,66 @@
+"""The paper's figures, reproduced: one function per figure, and :func:`reproduce`.
+
+Every figure is computed from the built-in ``paper`` world simulated with :data:`SEED`, so
+``fhslam reproduce`` always writes the same pictures. Figures 1-5 belong to Loop 1
+(feature extraction); Figures 6-11 are the paper's sketches of Loop 2 (line attributes, the
+four similarity conditions, merging), drawn from small hand-made examples whose numbers are
+computed by :mod:`fhslam.lines` and :mod:`fhslam.matching`; Figure 12 is a schematic of the
+robot.
+
+The package keeps the scenes apart from the drawing: :mod:`fhslam.figures.scenes` builds the
+data (the simulated logs, the scan shown, the worked examples of Figs. 6-11) without
+Matplotlib, and :mod:`fhslam.figures.paper` draws each figure from them. Everything is
+re-exported here, so ``from fhslam.figures import ...`` works for both.
+"""
+
+from fhslam.figures.paper import (
+    SIMILARITY_CAPTIONS,
+    fig01_hough_principle,
+    fig02_environment,
+    fig03_extended_points,
+    fig04_clusters,
+    fig05_lines,
+    fig06_line_attributes,
+    fig07_to_10_similarity,
+    fig11_merging,
+    fig12_pioneer,
+    fig13_environment_map,
+    fig14_slam_result,
+    reproduce,
+)
+from fhslam.figures.scenes import (
+    SEED,
+    SIMILARITY_POSE,
+    Pose,
+    figure_scan,
+    line_attributes_example,
+    merging_example,
+    paper_log,
+    similarity_examples,
+    slam_log,
+)
+
+__all__ = [
+    "SEED",
+    "SIMILARITY_CAPTIONS",
+    "SIMILARITY_POSE",
+    "Pose",
+    "fig01_hough_principle",
+    "fig02_environment",
+    "fig03_extended_points",
+    "fig04_clusters",
+    "fig05_lines",
+    "fig06_line_attributes",
+    "fig07_to_10_similarity",
+    "fig11_merging",
+    "fig12_pioneer",
+    "fig13_environment_map",
+    "fig14_slam_result",
+    "figure_scan",
+    "line_attributes_example",
+    "merging_example",
+    "paper_log",
+    "reproduce",
+    "similarity_examples",
+    "slam_log",
+]

@@ -20,3 +20,10 @@ class InputError(ValueError):
 class MissingInputError(FileNotFoundError, InputError):
     """An input file (or dataset) that does not exist. Also a :class:`FileNotFoundError`,
     with ``filename`` set where one is known."""
+
+    def __init__(self, message: str, filename: str | None = None) -> None:
+        super().__init__(message)
+        self.filename = filename
+
+    def __str__(self) -> str:  # the message, not OSError's "[Errno ...] ..." layout
+        return str(self.args[0])

@@ -324,3 +324,64 @@ def test_slam_on_a_dataset_name_then_relations(tmp_path, real_data, monkeypatch)
     r = run("evaluate", str(traj), "--relations", "aces")
     assert r.returncode == 2 and "no relation can be used" in r.stderr
     assert r.stderr.count("\n") == 1
+
+
+def test_info_reads_a_bag_and_reports_the_max_range(tmp_path, capsys):
+    """``fhslam info`` reads whatever ``fhslam slam`` reads, here a ROS bag."""
+    from test_rosbag import write_bag
+
+    bag = write_bag(tmp_path / "g.bag", scans=5)
+    assert main(["info", str(bag)]) == 0
+    text = capsys.readouterr().out
+    assert "5 scans of 181 beams" in text and "max range" in text
+    assert main(["info", str(bag), "--max-range", "3.5"]) == 0
+    assert "max range 3.5 m (--max-range)" in capsys.readouterr().out
+
+
+def test_info_on_a_dataset_name_reports_the_no_return_reading(real_data, monkeypatch, capsys):
+    monkeypatch.setenv("FHSLAM_DATA", str(real_data))
+    assert main(["info", "mit-csail"]) == 0
+    text = capsys.readouterr().out
+    assert "no-return reading: 81.91 m" in text  # the SICK's 80 m mode code in this log
+
+
+@pytest.mark.parametrize("value", ["0", "-1", "inf", "nan", "far"])
+def test_max_range_must_be_a_positive_number(tmp_path, value):
+    r = run("info", "paper.clf", "--max-range", value)
+    assert r.returncode == 2 and "--max-range" in r.stderr and "Traceback" not in r.stderr
+
+
+def test_slam_max_range_drops_far_readings(tmp_path):
+    """``--max-range`` overrides the log's: readings beyond it give no points, so a short
+    range leaves fewer lines to match and the trajectory changes."""
+    log_path = tmp_path / "p.clf"
+    main(["simulate", "paper", "--log", str(log_path), "--truth", str(tmp_path / "t.txt")])
+    for name, extra in (("full", []), ("short", ["--max-range", "1.0"])):
+        out = tmp_path / f"{name}.txt"
+        args = ["slam", str(log_path), "--trajectory", str(out), "--quiet", *extra]
+        assert main(args) == 0
+    _, full = read_trajectory(tmp_path / "full.txt")
+    _, short = read_trajectory(tmp_path / "short.txt")
+    assert not np.allclose(full, short, atol=1e-3)
+
+
+def test_a_bug_is_not_reported_as_bad_input(monkeypatch):
+    """The command catches only InputError: any other exception is a bug in the package
+    and keeps its traceback instead of becoming a one-line "bad input" message."""
+    import fhslam.cli
+
+    def broken(args):
+        raise ValueError("an internal inconsistency")
+
+    monkeypatch.setattr(fhslam.cli, "_simulate", broken)
+    with pytest.raises(ValueError, match="internal inconsistency"):
+        main(["simulate", "paper", "--log", "x.clf", "--truth", "t.txt"])
+
+
+def test_an_output_that_cannot_be_written_is_one_line_and_leaves_nothing(tmp_path):
+    r = run(
+        "simulate", "paper", "--log", str(tmp_path / "no" / "dir" / "p.clf"), "--truth", "t.txt"
+    )
+    assert r.returncode == 2 and r.stderr.count("\n") == 1
+    assert "p.clf: cannot write" in r.stderr
+    assert list(tmp_path.iterdir()) == []

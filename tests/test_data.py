@@ -215,7 +215,8 @@ def test_download_of_a_real_entry_uses_its_github_url(fake, monkeypatch):
 
     monkeypatch.setattr(data, "__file__", str(fake / "site" / "pkg" / "fhslam" / "datasets.py"))
     monkeypatch.setattr(pooch, "retrieve", retrieve)
-    find_dataset("aces", kind="relations", download=True)
+    got = find_dataset("aces", kind="relations", download=True)
+    assert seen, f"not downloaded: found {got}"
     assert seen == {
         "url": "https://raw.githubusercontent.com/INESCTEC/ricoslam/"
         "52bfaa91c8e5e56f119265d409b1692ca29d48d2/"

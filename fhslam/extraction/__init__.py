@@ -2,7 +2,8 @@
 
 :mod:`fhslam.extraction.fast_hough` holds the steps (clustering, "extending" the points,
 the slope histogram, the restricted Hough vote) and :func:`extract_lines`, the whole loop;
-:mod:`fhslam.extraction._kernels` their compiled (numba) per-cluster kernels.
+:mod:`fhslam.extraction._kernels` their compiled (numba) per-cluster kernels;
+:mod:`fhslam.extraction.params` the thresholds.
 """
 
 from fhslam.extraction.fast_hough import (

@@ -9,25 +9,26 @@ robot.
 
 The package keeps the scenes apart from the drawing: :mod:`fhslam.figures.scenes` builds the
 data (the simulated logs, the scan shown, the worked examples of Figs. 6-11) without
-Matplotlib, and :mod:`fhslam.figures.paper` draws each figure from them. Everything is
+Matplotlib; :mod:`fhslam.figures.loop1` (Figs. 1-5), :mod:`fhslam.figures.loop2` (Figs.
+6-11) and :mod:`fhslam.figures.slam` (Figs. 12-14) draw them, and :mod:`fhslam.figures.paper`
+writes them all (:func:`reproduce`). Everything is
 re-exported here, so ``from fhslam.figures import ...`` works for both.
 """
 
-from fhslam.figures.paper import (
-    SIMILARITY_CAPTIONS,
+from fhslam.figures.loop1 import (
     fig01_hough_principle,
     fig02_environment,
     fig03_extended_points,
     fig04_clusters,
     fig05_lines,
+)
+from fhslam.figures.loop2 import (
+    SIMILARITY_CAPTIONS,
     fig06_line_attributes,
     fig07_to_10_similarity,
     fig11_merging,
-    fig12_pioneer,
-    fig13_environment_map,
-    fig14_slam_result,
-    reproduce,
 )
+from fhslam.figures.paper import reproduce
 from fhslam.figures.scenes import (
     SEED,
     SIMILARITY_POSE,
@@ -39,6 +40,7 @@ from fhslam.figures.scenes import (
     similarity_examples,
     slam_log,
 )
+from fhslam.figures.slam import fig12_pioneer, fig13_environment_map, fig14_slam_result
 
 __all__ = [
     "SEED",

@@ -36,9 +36,7 @@ def input_path(path: str | os.PathLike[str], what: str = "") -> Path:
     p = Path(path)
     what = f"{what} file" if what else "file"
     if not p.exists():
-        err = MissingInputError(f"{p}: no such {what}")
-        err.filename = str(p)
-        raise err
+        raise MissingInputError(f"{p}: no such {what}", str(p))
     if not p.is_file():
         kind = "a directory" if p.is_dir() else "not a regular file"
         raise InputError(f"{p}: is {kind}, not a {what}")
@@ -52,9 +50,7 @@ def reading(path: str | os.PathLike[str]) -> Iterator[None]:
     try:
         yield
     except FileNotFoundError as e:
-        err = MissingInputError(f"{path}: no such file")
-        err.filename = str(path)
-        raise err from e
+        raise MissingInputError(f"{path}: no such file", str(path)) from e
     except OSError as e:
         raise InputError(f"{path}: cannot read ({e.strerror or e})") from None
 

@@ -1,0 +1,60 @@
+"""Opening inputs and writing outputs: errors naming the path, no half-written files."""
+
+from __future__ import annotations
+
+import os
+
+import pytest
+
+from fhslam.errors import InputError, MissingInputError
+from fhslam.io import read_map, read_trajectory, write_map
+from fhslam.io.files import atomic_output, input_path
+
+
+def test_missing_input_is_missing_input_error_and_file_not_found(tmp_path):
+    p = tmp_path / "nope.txt"
+    with pytest.raises(MissingInputError, match=r"nope\.txt: no such file") as e:
+        read_trajectory(p)
+    assert isinstance(e.value, FileNotFoundError) and isinstance(e.value, InputError)
+    assert e.value.filename == str(p)
+
+
+def test_a_directory_is_not_an_input_file(tmp_path):
+    with pytest.raises(InputError, match="is a directory, not a map file"):
+        read_map(tmp_path)
+    with pytest.raises(InputError, match="is a directory, not a file"):
+        input_path(tmp_path)
+
+
+def test_atomic_output_leaves_nothing_when_the_writer_fails(tmp_path):
+    out = tmp_path / "out.txt"
+    out.write_text("old\n")
+    with pytest.raises(RuntimeError), atomic_output(out) as f:
+        f.write("half")
+        raise RuntimeError("interrupted")
+    assert out.read_text() == "old\n"  # the old file stands, no temporary left behind
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["out.txt"]
+
+
+def test_atomic_output_replaces_the_file_when_complete(tmp_path):
+    out = tmp_path / "out.txt"
+    with atomic_output(out) as f:
+        f.write("new\n")
+    assert out.read_text() == "new\n"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["out.txt"]
+
+
+def test_unwritable_output_names_the_path(tmp_path):
+    with pytest.raises(InputError, match=r"m\.json: cannot write"):
+        write_map(tmp_path / "missing" / "m.json", [])
+    with pytest.raises(InputError, match="is a directory"):
+        write_map(tmp_path, [])
+
+
+@pytest.mark.skipif(os.geteuid() == 0, reason="root may read any file")
+def test_unreadable_input_names_the_path(tmp_path):
+    p = tmp_path / "t.txt"
+    p.write_text("0 0 0 0\n")
+    p.chmod(0)
+    with pytest.raises(InputError, match=r"t\.txt: cannot read"):
+        read_trajectory(p)

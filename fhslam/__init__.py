@@ -44,6 +44,7 @@ _API: dict[str, str] = {
     "METHODS": "fhslam.pipeline",
     "SlamResult": "fhslam.pipeline",
     "run_slam": "fhslam.pipeline",
+    "run_backend": "fhslam.pipeline",
     # data
     "Log": "fhslam.io",
     "load_log": "fhslam.datasets",
@@ -76,7 +77,7 @@ if TYPE_CHECKING:  # for type checkers and IDEs: the same names, eagerly
     from fhslam.io import Log
     from fhslam.lines import Line
     from fhslam.matching import MatchParams, match_lines, merge, similarity
-    from fhslam.pipeline import METHODS, SlamResult, run_slam
+    from fhslam.pipeline import METHODS, SlamResult, run_backend, run_slam
     from fhslam.reference_map import ReferenceMap
     from fhslam.scan import Scan, scan_to_points
     from fhslam.sim import degrade, load_world, simulate

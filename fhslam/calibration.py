@@ -26,9 +26,14 @@ class Calibration:
     """Result of :func:`calibrate_pose`."""
 
     pose: NDArray[np.float64]
+    """The calibrated pose ``(x, y, theta)``, world frame."""
     correction: NDArray[np.float64]
+    """``pose - predicted`` (heading wrapped): what the calibration moved."""
     constrained: tuple[bool, bool]
+    """Whether the position is constrained along its weakest / strongest direction (a
+    corridor constrains only the strongest)."""
     n_pairs: int
+    """Matched line pairs used."""
 
 
 def calibrate_pose(

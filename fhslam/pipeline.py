@@ -36,7 +36,7 @@ from fhslam.slam import (
     StepResult,
 )
 
-__all__ = ["METHODS", "Method", "SlamResult", "run_backend", "run_slam"]
+__all__ = ["METHODS", "Method", "SlamResult", "make_backend", "run_backend", "run_slam"]
 
 
 @dataclass

@@ -78,8 +78,9 @@ def _relations_error(real_data, name):
 
 
 def test_intel_relations_error_meets_issue_5(real_data):
-    """The whole Intel log: issue 5 asks for <= 0.50 m (aim 0.05 m); measured 0.041 m,
-    0.82 deg, over all 2984 relations (raw odometry: 7.38 m)."""
+    """The whole Intel log: issue 5 asks for <= 0.50 m (aim 0.05 m); measured 0.043 m,
+    0.84 deg, over all 2984 relations (raw odometry: 7.38 m). The bound leaves room for
+    last-bit differences between CPUs, which move this method by millimetres here."""
     e = _relations_error(real_data, "intel")
     assert e.n_used == e.n_total == 2984
     assert e.trans_mean <= 0.05
@@ -89,7 +90,8 @@ def test_intel_relations_error_meets_issue_5(real_data):
 def test_held_out_aces_relations_error_meets_issue_5(real_data):
     """ACES was never run while the method was developed and tuned (held out); issue 5
     asks for <= 0.30 m (raw odometry 0.55 m). Measured once, with the final defaults:
-    0.161 m."""
+    0.161 m; 0.043 m since the no-return code (50 m) is detected instead of the largest
+    reading (issue 9)."""
     e = _relations_error(real_data, "aces")
     assert e.n_used == e.n_total
     assert e.trans_mean <= 0.30

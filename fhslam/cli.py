@@ -38,6 +38,27 @@ def _load(args: argparse.Namespace):
     )
 
 
+_OFFSET_SOURCES = {
+    "PARAM": "from the log's PARAM lines",
+    "laser pose": "from the laser poses of the log's laser lines",
+    "none": "none stated in the log: the laser at the robot's origin",
+    "tf_static": "from the bag's /tf_static base_link -> laser (zero if none)",
+    None: "source not recorded by the reader",
+}
+
+
+def _laser_offset_line(log) -> str:
+    """``info``'s line on the laser's mount in use (``Log.laser_offset``) and its source,
+    to 0.1 mm and 0.0001° (a mount read off printed laser poses carries their rounding)."""
+    import math
+
+    x, y, theta = (float(v) for v in log.laser_offset)
+    x, y, deg = (round(v, 4) + 0.0 for v in (x, y, math.degrees(theta)))  # + 0.0: no "-0"
+    source = getattr(log, "laser_offset_source", None)
+    where = _OFFSET_SOURCES.get(source, source)
+    return f"laser offset x {x:g} m, y {y:g} m, theta {deg:g} deg ({where})"
+
+
 def _info(args: argparse.Namespace) -> None:
     from fhslam.evaluate import log_summary
 
@@ -48,6 +69,7 @@ def _info(args: argparse.Namespace) -> None:
     code = "none found" if s.no_return is None else f"{s.no_return:g} m"
     given = " (--max-range)" if args.max_range is not None else ""
     print(f"max range {s.max_range:g} m{given}; no-return reading: {code}")
+    print(_laser_offset_line(log))
     print(f"fast Hough lines per scan (median of {s.n_sampled} scans): {s.median_lines:g}")
 
 

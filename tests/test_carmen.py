@@ -4,11 +4,14 @@ from __future__ import annotations
 
 import os
 import re
+import warnings
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
 import pytest
 
+from fhslam.geometry import compose
 from fhslam.io import (
     CarmenFormatError,
     Log,
@@ -19,6 +22,7 @@ from fhslam.io import (
     write_carmen,
     write_trajectory,
 )
+from fhslam.io.carmen import CarmenWarning
 from fhslam.io.log import no_return_reading
 from fhslam.sim import LaserParams, paper_world, simulate
 
@@ -205,13 +209,14 @@ def test_binary_file_is_a_format_error(tmp_path):
         read_carmen(path)
 
 
-def robotlaser1(ranges, remissions, robot_pose, stamp):
+def robotlaser1(ranges, remissions, robot_pose, stamp, laser_pose=(9, 9, 9)):
     """A ROBOTLASER1 line: start -90 deg, fov 180, resolution 45 deg, max range 20 m."""
     head = f"ROBOTLASER1 0 {-np.pi / 2!r} {np.pi!r} {np.pi / 4!r} 20.0 0.01 0 {len(ranges)}"
     rem = "" if remissions is None else f" {len(remissions)} " + " ".join(map(str, remissions))
     pose = " ".join(map(str, robot_pose))
+    laser = " ".join(map(str, laser_pose))
     return (
-        f"{head} {' '.join(map(str, ranges))}{rem} 9 9 9 {pose} 0.1 0.0 0.5 0.3 0.0 "
+        f"{head} {' '.join(map(str, ranges))}{rem} {laser} {pose} 0.1 0.0 0.5 0.3 0.0 "
         f"{stamp} host {stamp}"
     )
 
@@ -338,3 +343,293 @@ def test_max_range_can_be_overridden_and_is_reported(tmp_path):
     path.write_text(GOOD)
     assert read_carmen(path, max_range=2.05).max_range == 2.05
     assert len(read_carmen(path, max_range=2.05).scan(0).points()[0]) == 3  # 1.0 1.5 2.0
+
+
+# ---------------------------------------------------------------------------- laser mount
+
+ODOM_PATH = np.array(
+    [[0.0, 0.0, 0.0], [1.0, 0.1, 0.3], [1.8, 0.6, 1.2], [2.0, 1.5, 2.4], [1.4, 2.1, 3.1],
+     [0.6, 2.0, -2.9]]
+)  # fmt: skip
+"""Odometry of the hand-made mount logs: it turns through ±π, so a wrongly composed or
+unwrapped offset shows."""
+
+MOUNT = np.array([0.22, -0.05, 0.1])
+
+
+def _pose(p) -> str:
+    return " ".join(f"{v:f}" for v in p)  # CARMEN's %f: 6 decimals
+
+
+def mount_log(laser_poses, odometry=ODOM_PATH, params: str = "", n: int = 5) -> str:
+    """A FLASER log: ``params`` (PARAM lines) then one line per pose pair, CARMEN style."""
+    lines = [params] if params else []
+    for k, (laser, odom) in enumerate(zip(laser_poses, odometry, strict=True)):
+        ranges = " ".join(f"{1.0 + 0.5 * b + 0.01 * k:.2f}" for b in range(n))
+        t = f"{100.0 + 0.2 * k:f}"
+        lines.append(f"FLASER {n} {ranges} {_pose(laser)} {_pose(odom)} {t} host {t}")
+    return "\n".join(lines) + "\n"
+
+
+def _read_quietly(path: Path) -> Log:
+    """read_carmen, failing the test on any warning."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        return read_carmen(path)
+
+
+def test_mount_from_the_flaser_laser_poses(tmp_path):
+    """No PARAM: the laser poses sit at one constant offset from the odometry (to CARMEN's
+    printed precision), so that offset is the mount."""
+    path = tmp_path / "mounted.clf"
+    path.write_text(mount_log(compose(ODOM_PATH, MOUNT)))
+    log = _read_quietly(path)
+    np.testing.assert_allclose(log.laser_offset, MOUNT, rtol=0, atol=5e-6)
+    assert log.laser_offset_source == "laser pose"
+    np.testing.assert_allclose(log.odometry, ODOM_PATH, rtol=0, atol=1e-12)  # not the laser's
+
+
+def test_a_rear_facing_mount_across_the_angle_wrap(tmp_path):
+    """A laser looking backwards: its offset angle is ±π, which must not read as varying."""
+    mount = np.array([-0.3, 0.0, np.pi])
+    path = tmp_path / "rear.clf"
+    path.write_text(mount_log(compose(ODOM_PATH, mount)))
+    log = _read_quietly(path)
+    np.testing.assert_allclose(log.laser_offset[:2], mount[:2], rtol=0, atol=5e-6)
+    assert abs(abs(log.laser_offset[2]) - np.pi) < 5e-6
+    assert log.laser_offset_source == "laser pose"
+
+
+def test_mount_from_param_lines(tmp_path):
+    """PARAM lines state the mount; here the laser poses agree with it (CARMEN's robot
+    module computed them from it), so no warning. The tail of a PARAM line may be short."""
+    params = (
+        "PARAM robot_frontlaser_offset 0.22 100.0 host 100.0\n"
+        "PARAM robot_frontlaser_side_offset -0.05 nohost 0\n"
+        "PARAM robot_frontlaser_angular_offset 0.1 100.0 host 100.0"
+    )
+    path = tmp_path / "param.clf"
+    path.write_text(mount_log(compose(ODOM_PATH, MOUNT), params=params))
+    log = _read_quietly(path)
+    assert log.laser_offset.tolist() == [0.22, -0.05, 0.1]  # exactly the stated values
+    assert log.laser_offset_source == "PARAM"
+
+
+def test_param_mount_with_corrected_laser_poses(tmp_path):
+    """Laser poses that are corrected poses (not odometry + a constant) say nothing about
+    the mount and do not contradict the PARAM; an unstated PARAM component is 0."""
+    rng = np.random.default_rng(0)
+    corrected = ODOM_PATH + rng.normal(0, 0.2, ODOM_PATH.shape)
+    path = tmp_path / "corrected.clf"
+    path.write_text(mount_log(corrected, params="PARAM robot_frontlaser_offset 0.04 0 host 0"))
+    log = _read_quietly(path)
+    assert log.laser_offset.tolist() == [0.04, 0.0, 0.0]
+    assert log.laser_offset_source == "PARAM"
+
+
+def test_corrected_laser_poses_without_param_give_no_mount(tmp_path):
+    """Laser poses off the odometry by 5 mm more on one scan than on the others: not a
+    constant mount (the tolerance is 1 mm), so no offset at all."""
+    laser = compose(ODOM_PATH, MOUNT)
+    laser[3] = compose(ODOM_PATH[3], MOUNT + np.array([0.005, 0.0, 0.0]))
+    path = tmp_path / "varying.clf"
+    path.write_text(mount_log(laser))
+    log = _read_quietly(path)
+    assert log.laser_offset.tolist() == [0.0, 0.0, 0.0]
+    assert log.laser_offset_source == "none"
+
+
+def test_param_and_laser_poses_that_disagree_warn_and_param_wins(tmp_path):
+    """A log rewritten by a program that copied the odometry into both triples, keeping
+    the PARAM line of a laser 4 cm ahead of the robot's centre."""
+    path = tmp_path / "disagree.clf"
+    path.write_text(mount_log(ODOM_PATH, params="PARAM robot_frontlaser_offset 0.04 0 host 0"))
+    with pytest.warns(CarmenWarning) as record:
+        log = read_carmen(path)
+    assert len(record) == 1
+    message = str(record[0].message)
+    assert str(path) in message and "line 1" in message
+    assert "x 0.04 m" in message and "x 0 m" in message  # both values
+    assert log.laser_offset.tolist() == [0.04, 0.0, 0.0]
+    assert log.laser_offset_source == "PARAM"
+
+
+def test_mount_from_robotlaser1(tmp_path):
+    """ROBOTLASER1 lines carry laser_pose and robot_pose: a constant offset is the mount;
+    the placeholder laser pose (9 9 9) of the other ROBOTLASER1 test is none."""
+    odom = ODOM_PATH[:4]
+    laser = compose(odom, [0.22, 0.0, 0.0])
+    path = tmp_path / "robot.clf"
+    path.write_text(
+        "".join(
+            robotlaser1([1, 2, 3, 4, 5], [7] * 5, [f"{v:f}" for v in o], 1.0 + k,
+                        [f"{v:f}" for v in lp]) + "\n"
+            for k, (o, lp) in enumerate(zip(odom, laser, strict=True))
+        )
+    )  # fmt: skip
+    log = _read_quietly(path)
+    np.testing.assert_allclose(log.laser_offset, [0.22, 0.0, 0.0], rtol=0, atol=5e-6)
+    assert log.laser_offset_source == "laser pose"
+    np.testing.assert_allclose(log.odometry, odom, rtol=0, atol=1e-6)
+
+    placeholder = tmp_path / "placeholder.clf"
+    placeholder.write_text(
+        robotlaser1([1, 2, 3, 4, 5], None, [1.0, 2.0, 0.5], 1.0)
+        + "\n"
+        + robotlaser1([2, 3, 4, 5, 6], None, [1.5, 2.0, 0.5], 2.0)
+        + "\n"
+    )
+    log = _read_quietly(placeholder)
+    assert log.laser_offset.tolist() == [0.0, 0.0, 0.0] and log.laser_offset_source == "none"
+
+
+def test_robotlaser1_ignores_the_flaser_resolution_param(tmp_path):
+    path = tmp_path / "robot.clf"
+    path.write_text(
+        "PARAM laser_front_laser_resolution 1.0 0 host 0\n"
+        + robotlaser1([1, 2, 3, 4, 5], None, [1.0, 2.0, 0.5], 1.0)
+        + "\n"
+    )
+    log = _read_quietly(path)
+    np.testing.assert_allclose(np.degrees(log.angles), [-90, -45, 0, 45, 90], atol=1e-9)
+
+
+def test_read_mit_csail_has_no_mount_and_unchanged_bearings(real_data, monkeypatch):
+    """mit-csail.clf has no PARAM lines and copies the odometry into the laser poses of all
+    1988 FLASER lines: a mount of exactly zero, and CARMEN's default 0.5° bearings."""
+    from fhslam.datasets import find_dataset
+
+    monkeypatch.setenv("FHSLAM_DATA", str(real_data))
+    path = find_dataset("mit-csail")
+    if not path.is_file():  # pragma: no cover (find_dataset raises first)
+        pytest.skip("mit-csail.clf not found")
+    log = _read_quietly(path)
+    assert len(log) == 1988
+    assert log.laser_offset.tolist() == [0.0, 0.0, 0.0]
+    assert log.laser_offset_source == "laser pose"
+    assert np.array_equal(log.angles, flaser_angles(361))
+    assert np.array_equal(log.angles, np.linspace(-np.pi / 2, np.pi / 2, 361))
+
+
+# ---------------------------------------------------------------------------- beam layout
+
+
+@pytest.mark.parametrize(
+    ("params", "n", "degrees"),
+    [
+        ("PARAM laser_front_laser_resolution 10.0 0 host 0", 5, [-20, -10, 0, 10, 20]),
+        # 4 beams 45° apart over 180°: the driver's last beam (+90°) is not sent
+        ("PARAM laser_front_laser_resolution 45\nPARAM laser_front_laser_fov 180", 4,
+         [-90, -45, 0, 45]),
+        ("PARAM laser_front_laser_fov 100.0 0 host 0", 5, [-50, -25, 0, 25, 50]),
+        # 180 beams at 1°: the same bearings as CARMEN's own guess
+        ("PARAM laser_front_laser_resolution 1.0", 180, np.arange(-90.0, 90.0)),
+        # 400 beams at 0.25°: a SICK in its 100° mode, centred (the guess says -90°..+10°)
+        ("PARAM laser_front_laser_resolution 0.25", 400, -50 + 0.25 * np.arange(400)),
+    ],
+)  # fmt: skip
+def test_resolution_and_fov_params_set_the_flaser_bearings(tmp_path, params, n, degrees):
+    path = tmp_path / "layout.clf"
+    path.write_text(mount_log(ODOM_PATH, params=params, n=n))
+    log = _read_quietly(path)
+    np.testing.assert_allclose(np.degrees(log.angles), degrees, rtol=0, atol=1e-9)
+    if n == 5:  # the default rule spreads 5 beams over 180°
+        assert np.degrees(flaser_angles(5)[0]) == pytest.approx(-90.0)
+
+
+# (PARAM lines, line number of the error, expected message fragment)
+BAD_PARAMS = {
+    "missing value": (
+        "PARAM robot_frontlaser_offset", 1, "PARAM robot_frontlaser_offset has no value"
+    ),
+    "non-numeric offset": (
+        "PARAM x 1\nPARAM robot_frontlaser_side_offset left 0 host 0", 2,
+        "robot_frontlaser_side_offset value 'left' is not a number",
+    ),
+    "nan angle": (
+        "PARAM robot_frontlaser_angular_offset nan 0 host 0", 1, "is not finite"
+    ),
+    "angle in degrees": (
+        "PARAM robot_frontlaser_angular_offset 90 0 host 0", 1, "radians, not degrees"
+    ),
+    "non-numeric resolution": (
+        "PARAM laser_front_laser_resolution 0.5deg 0 host 0", 1, "is not a number"
+    ),
+    "zero resolution": ("PARAM laser_front_laser_resolution 0 0 host 0", 1, "not an angle"),
+    "negative fov": ("PARAM laser_front_laser_fov -180 0 host 0", 1, "not an angle"),
+    "contradiction": (
+        "PARAM robot_frontlaser_offset 0.1\nPARAM robot_frontlaser_offset 0.2", 2,
+        "contradicts line 1",
+    ),
+    "over a full turn": (
+        "PARAM laser_front_laser_resolution 100", 1,
+        "5 beams of the FLASER lines \\(first: line 2\\) a field of view of 400 degrees",
+    ),
+    "fov and resolution disagree": (
+        "PARAM laser_front_laser_fov 180\nPARAM laser_front_laser_resolution 1.0", 2,
+        "make scans of 181 beams \\(or 180 without the last\\), but the FLASER lines "
+        "\\(first: line 3\\) hold 5",
+    ),
+    "no name": ("PARAM", 1, "PARAM line without a parameter name"),
+}  # fmt: skip
+
+
+@pytest.mark.parametrize("case", list(BAD_PARAMS))
+def test_bad_params_name_file_and_line(tmp_path, case):
+    params, lineno, fragment = BAD_PARAMS[case]
+    path = tmp_path / "params.clf"
+    path.write_text(mount_log(ODOM_PATH, params=params))
+    with pytest.raises(CarmenFormatError, match=rf"^{re.escape(str(path))}:{lineno}: .*{fragment}"):
+        read_carmen(path)
+
+
+def test_other_params_are_ignored_whatever_their_value(tmp_path):
+    params = (
+        "PARAM robot_use_laser on 0 host 0\n"
+        "PARAM laser_front_laser_dev /dev/ttyS0 0 host 0\n"
+        "PARAM robot_rearlaser_offset behind 0 host 0\n"  # not the front laser's mount
+        "PARAM some_flag\n"
+        "PARAM robot_frontlaser_offset 0.1 0 host 0\n"
+        "PARAM robot_frontlaser_offset 0.1 5 host 5"  # restated, the same: fine
+    )
+    path = tmp_path / "params.clf"
+    path.write_text(mount_log(compose(ODOM_PATH, [0.1, 0, 0]), params=params))
+    log = _read_quietly(path)
+    assert log.laser_offset.tolist() == [0.1, 0.0, 0.0] and log.laser_offset_source == "PARAM"
+    assert np.array_equal(log.angles, flaser_angles(5))
+
+
+# ---------------------------------------------------------------------------- writing a mount
+
+
+@pytest.mark.parametrize("beams", ["flaser", "robotlaser1"])
+def test_written_mount_reads_back_exactly(tmp_path, beams):
+    laser = None if beams == "flaser" else LaserParams(n_beams=271, fov_deg=270.0, max_range=10.0)
+    log = simulate(paper_world(), seed=0, max_scans=20, **({"laser": laser} if laser else {}))
+    mounted = replace(log, laser_offset=np.array([0.25, -0.1, 0.1]))
+    path = tmp_path / "mounted.clf"
+    write_carmen(mounted, path)
+    text = path.read_text()
+    assert "PARAM robot_frontlaser_offset 0.25 " in text
+    assert "PARAM robot_frontlaser_side_offset -0.1 " in text
+    assert "PARAM robot_frontlaser_angular_offset 0.1 " in text
+    back = _read_quietly(path)  # PARAM and laser poses agree: no warning
+    assert back.laser_offset.tolist() == [0.25, -0.1, 0.1]
+    assert back.laser_offset_source == "PARAM"
+    assert np.array_equal(back.odometry, log.odometry)
+    # The laser-pose triple is the odometry + the mount, as CARMEN's robot module writes it.
+    first = next(ln.split() for ln in text.splitlines() if ln.startswith(("FLASER", "ROBOTL")))
+    at = 2 + log.n_beams if beams == "flaser" else 10 + log.n_beams
+    np.testing.assert_allclose(
+        np.array(first[at : at + 6], dtype=float),
+        np.r_[compose(log.odometry[0], mounted.laser_offset), log.odometry[0]],
+        rtol=0,
+        atol=1e-12,
+    )
+
+
+def test_written_log_without_mount_states_zero(sim_log, tmp_path):
+    path = tmp_path / "paper.clf"
+    write_carmen(sim_log, path)
+    back = _read_quietly(path)
+    assert back.laser_offset.tolist() == [0.0, 0.0, 0.0] and back.laser_offset_source == "PARAM"

@@ -64,8 +64,43 @@ def test_info_summarises_a_log(tmp_path, capsys):
     assert main(["info", str(out)]) == 0
     text = capsys.readouterr().out
     assert "916 scans of 181 beams" in text
+    # write_carmen states the (zero) mount of a simulated log in PARAM lines
+    assert "laser offset x 0 m, y 0 m, theta 0 deg (from the log's PARAM lines)" in text
     median_lines = float(text.rsplit(":", 1)[1])
     assert 3 <= median_lines <= 15  # an office seen over 180°: several walls per scan
+
+
+def test_info_reports_the_laser_offset_and_its_source(tmp_path, capsys):
+    from dataclasses import replace
+
+    from fhslam.io import write_carmen
+
+    log = simulate(paper_world(), seed=0, max_scans=5)
+    mounted = tmp_path / "mounted.clf"
+    write_carmen(replace(log, laser_offset=np.array([0.25, -0.1, np.radians(30)])), mounted)
+    assert main(["info", str(mounted)]) == 0
+    text = capsys.readouterr().out
+    assert "laser offset x 0.25 m, y -0.1 m, theta 30 deg (from the log's PARAM lines)" in text
+
+    # No PARAM lines; laser poses 4 cm ahead of the odometry on every line.
+    rows = [(0.0, 0.0, 0.0), (1.0, 0.0, 0.5), (1.5, 0.5, 1.0)]
+    lines = []
+    for k, (x, y, th) in enumerate(rows):
+        lx, ly = x + 0.04 * np.cos(th), y + 0.04 * np.sin(th)
+        ranges = " ".join(["2.0"] * 181)
+        lines.append(f"FLASER 181 {ranges} {lx:f} {ly:f} {th:f} {x:f} {y:f} {th:f} {k}.0 h {k}.0")
+    posed = tmp_path / "posed.clf"
+    posed.write_text("\n".join(lines) + "\n")
+    assert main(["info", str(posed)]) == 0
+    text = capsys.readouterr().out
+    assert "laser offset x 0.04 m, y 0 m, theta 0 deg (from the laser poses" in text
+
+    # Laser poses that are not odometry + a constant: no mount.
+    lines[1] = lines[1].replace(f"{1.0 + 0.04 * np.cos(0.5):f}", "1.300000", 1)
+    posed.write_text("\n".join(lines) + "\n")
+    assert main(["info", str(posed)]) == 0
+    text = capsys.readouterr().out
+    assert "laser offset x 0 m, y 0 m, theta 0 deg (none stated in the log" in text
 
 
 @pytest.mark.parametrize(
@@ -343,6 +378,8 @@ def test_info_on_a_dataset_name_reports_the_no_return_reading(real_data, monkeyp
     assert main(["info", "mit-csail"]) == 0
     text = capsys.readouterr().out
     assert "no-return reading: 81.91 m" in text  # the SICK's 80 m mode code in this log
+    # no PARAM lines; every laser pose is a copy of the odometry
+    assert "laser offset x 0 m, y 0 m, theta 0 deg (from the laser poses" in text
 
 
 @pytest.mark.parametrize("value", ["0", "-1", "inf", "nan", "far"])

@@ -1,33 +1,84 @@
 """CARMEN text logs: one message per line, ``NAME [contents] ipc_timestamp host logger_timestamp``.
 
 Read: ``FLASER`` (old format) and ``ROBOTLASER1`` laser messages become the scans of a
-:class:`~fhslam.io.log.Log`; ``#`` comments, blank lines and every other message (``ODOM``,
-``PARAM``, ``SYNC``, ``TRUEPOS``, ...) are skipped, since the laser messages carry the
-odometry pose themselves.
+:class:`~fhslam.io.log.Log`; ``PARAM`` lines are read for the laser's mount and beam
+layout (below); ``#`` comments, blank lines and every other message (``ODOM``, ``SYNC``,
+``TRUEPOS``, ...) are skipped, since the laser messages carry the odometry pose themselves.
 
 Write: one ``ODOM`` and one ``FLASER`` line per scan, every number as Python's shortest
-round-trip ``repr``, so reading the file back gives exactly the same floats. Both pose
-triples of a written ``FLASER`` line are the *odometry*; ground truth never goes into a log.
+round-trip ``repr``, so reading the file back gives exactly the same floats. The odometry
+triple of a written laser line is the *odometry*, its laser-pose triple the odometry ⊕
+``log.laser_offset``, and three ``PARAM`` lines state the mount; ground truth never goes
+into a log.
 
 Formats (CARMEN logger documentation; see ``data/SOURCES.md``)::
 
+    PARAM name value ipc_timestamp hostname logger_timestamp
     ODOM x y theta tv rv accel ipc_timestamp hostname logger_timestamp
     FLASER n r_1 ... r_n x y theta odom_x odom_y odom_theta ipc_timestamp hostname logger_ts
     ROBOTLASER1 laser_type start_angle field_of_view angular_resolution maximum_range
         accuracy remission_mode n r_1 ... r_n num_remissions [remissions]
         laser_x laser_y laser_theta robot_x robot_y robot_theta tv rv
         forward_safety_dist side_safety_dist turn_axis ipc_timestamp hostname logger_ts
+
+Conventions, from CARMEN's source: its log reader (``readlog.c``,
+``carmen_string_to_robot_laser_message_orig``) reads the ``FLASER`` triple ``x y theta``
+into the message's ``laser_pose`` and ``odom_x odom_y odom_theta`` into its ``robot_pose``
+(``ROBOTLASER1`` names them itself); the robot module that publishes these messages sets
+``laser_pose = robot_pose ⊕ (robot_frontlaser_offset, robot_frontlaser_side_offset,
+robot_frontlaser_angular_offset)`` (older versions: ``odom + offset·(cos θ, sin θ)``, the
+heading unchanged); the laser module's ``laser_front_laser_resolution`` and
+``laser_front_laser_fov`` are in degrees. The logger writes every parameter as
+``PARAM module_variable value ...``.
+
+The laser's mount, :attr:`Log.laser_offset <fhslam.io.log.Log>` (``robot_T_laser``, the
+laser's pose in the robot frame), comes from
+
+1. ``PARAM robot_frontlaser_offset`` (metres forward), ``robot_frontlaser_side_offset``
+   (metres to the left) and ``robot_frontlaser_angular_offset`` (radians counter-
+   clockwise) when the log states any of them (an unstated one is 0, CARMEN's default);
+2. else the laser poses, when ``relative(odometry, laser_pose)`` is one constant (within
+   :data:`MOUNT_TOLERANCE`) over every laser line of the log: then it is the mount. Logs
+   whose laser pose is a *corrected* pose (scan-matched, or the true pose) give an offset
+   that drifts with the correction, which says nothing about the mount; it is not used;
+3. else none: the laser at the robot's origin.
+
+When both ``PARAM`` lines and a constant laser-pose offset exist and differ (by more than
+the tolerance), the ``PARAM`` values win and a :class:`CarmenWarning` names the file and
+both values. The ``PARAM`` lines are the mount the robot was configured with, from which
+CARMEN's robot module computed the laser poses; laser poses that disagree were written by
+another program, and programs that rewrite CARMEN logs may copy the odometry into both
+triples (fhslam's own writer did, before issue 10): a zero offset that states nothing.
+``Log.laser_offset_source`` records the outcome: ``"PARAM"``, ``"laser pose"`` or
+``"none"``.
+
+The bearings of a ``FLASER`` scan: the line carries none. Without ``PARAM`` lines, CARMEN's
+reader's guess applies (:func:`flaser_angles`). With ``PARAM laser_front_laser_resolution``
+(degrees between beams) and/or ``laser_front_laser_fov`` (degrees), the scan is laid out
+as CARMEN's laser driver does, centred on the laser's heading (see :func:`flaser_angles`);
+the resolution times ``n − 1`` must not exceed 360°, and with both stated the beam count
+must be ``fov / resolution + 1`` (or one less: the last beam dropped). ``ROBOTLASER1``
+lines state their own start angle and resolution, which these ``PARAM`` lines do not
+override.
+
+A ``PARAM`` of one of these five names without a value, with a non-numeric or non-finite
+value, with an angle out of range (a resolution or field of view outside (0°, 360°], an
+angular offset beyond ±2π, i.e. given in degrees), or stated twice with different values
+is a :class:`CarmenFormatError`; every other ``PARAM`` (many hold strings) is ignored.
 """
 
 from __future__ import annotations
 
+import math
+import warnings
+from dataclasses import dataclass
 from os import PathLike
 
 import numpy as np
 from numpy.typing import NDArray
 
 from fhslam.errors import InputError
-from fhslam.geometry import relative, wrap_angle
+from fhslam.geometry import compose, relative, wrap_angle
 from fhslam.io.files import atomic_output, input_path, reading
 from fhslam.io.log import Log, effective_max_range, is_number
 
@@ -40,11 +91,43 @@ class CarmenFormatError(InputError):
     """A malformed CARMEN log. The message reads ``"{path}:{lineno}: {what is wrong}"``."""
 
 
+class CarmenWarning(UserWarning):
+    """A CARMEN log that contradicts itself, e.g. a ``PARAM`` mount its laser poses disagree
+    with (the reader goes on with the rule of the module docstring)."""
+
+
+MOUNT_TOLERANCE = (1e-3, 1e-3)
+"""How far (metres, radians) the laser-pose offsets of a log may scatter and still count as
+one constant mount, and how far the ``PARAM`` mount and that offset may differ and still
+agree. CARMEN prints poses to 1e-6 (``%f``), a thousandth of this."""
+
+MOUNT_PARAMS = (
+    "robot_frontlaser_offset",
+    "robot_frontlaser_side_offset",
+    "robot_frontlaser_angular_offset",
+)
+"""The ``PARAM`` names of the front laser's mount ``(x, y, theta)``: metres, metres, radians."""
+
+RESOLUTION_PARAM = "laser_front_laser_resolution"
+"""The ``PARAM`` of the front laser's angle between beams, degrees."""
+
+FOV_PARAM = "laser_front_laser_fov"
+"""The ``PARAM`` of the front laser's field of view, degrees."""
+
+_UNITS = dict.fromkeys(MOUNT_PARAMS[:2], "metres") | {
+    MOUNT_PARAMS[2]: "radians",
+    RESOLUTION_PARAM: "degrees",
+    FOV_PARAM: "degrees",
+}
+
+
 _GUESSED_INCREMENT = {180: 1.0, 181: 1.0, 360: 0.5, 361: 0.5, 400: 0.25, 401: 0.25}
 """CARMEN's ``carmen_laser_guess_angle_increment``: degrees between beams by beam count."""
 
 
-def flaser_angles(n: int) -> NDArray[np.float64]:
+def flaser_angles(
+    n: int, resolution: float | None = None, fov: float | None = None
+) -> NDArray[np.float64]:
     """Bearings of an old-format ``FLASER`` scan of ``n`` beams, by CARMEN's own rule.
 
     The message carries no angles. CARMEN's log reader (``carmen_string_to_robot_laser_
@@ -56,12 +139,43 @@ def flaser_angles(n: int) -> NDArray[np.float64]:
 
     The same rule reads bags converted from such logs (:func:`fhslam.io.read_bag`), whose
     converter wrote ``angle_increment = π/(n−1)`` without knowing better.
+
+    Where the log states the laser's ``resolution`` and/or ``fov`` (``PARAM
+    laser_front_laser_resolution`` / ``laser_front_laser_fov``, degrees), the scan is laid
+    out as CARMEN's laser driver does (``laser_main.c``, ``set_laser_config_structure``):
+    ``resolution`` apart, starting at ``-fov / 2``. An unstated ``fov`` is ``n × resolution``
+    when that is one of the SICK's fields of view, 100° or 180° (the driver drops the last
+    beam of such a scan: 180 beams at 1° start at -90°), else ``(n − 1) × resolution``
+    (centred). An unstated ``resolution`` is the guess above where it fits ``fov`` (``n`` is
+    ``fov / step`` or one more), else ``fov / (n − 1)``. Without either, the reader's rule.
+
+    Raises
+    ------
+    ValueError
+        For a non-positive ``resolution`` or ``fov``, or a layout spanning more than 360°.
     """
-    step = _GUESSED_INCREMENT.get(n)
-    span = np.pi if step is None else np.radians(step) * (n - 1)
-    if n in (181, 361):
-        span = np.pi  # exactly: the last bearing is +90°
-    return np.linspace(-np.pi / 2, -np.pi / 2 + span, n)
+    if resolution is None and fov is None:
+        step = _GUESSED_INCREMENT.get(n)
+        span = np.pi if step is None else np.radians(step) * (n - 1)
+        if n in (181, 361):
+            span = np.pi  # exactly: the last bearing is +90°
+        return np.linspace(-np.pi / 2, -np.pi / 2 + span, n)
+    for name, value in (("resolution", resolution), ("fov", fov)):
+        if value is not None and not (math.isfinite(value) and value > 0):
+            raise ValueError(f"flaser_angles: {name} must be a positive number, got {value}")
+    if resolution is None:
+        guess = _GUESSED_INCREMENT.get(n)
+        fits = guess is not None and any(math.isclose(fov / guess, k) for k in (n, n - 1))
+        resolution = guess if fits else fov / max(n - 1, 1)
+    if fov is None:
+        whole = n * resolution
+        fov = whole if any(math.isclose(whole, f) for f in (100.0, 180.0)) else (n - 1) * resolution
+    if (n - 1) * resolution > 360.0 + 1e-9:
+        raise ValueError(
+            f"flaser_angles: {n} beams {resolution:g}° apart span {(n - 1) * resolution:g}°, "
+            "more than a full turn"
+        )
+    return np.radians(-fov / 2) + np.radians(resolution) * np.arange(n)
 
 
 # ----------------------------------------------------------------------------------- writing
@@ -73,13 +187,18 @@ def _fmt(values: NDArray | list[float]) -> str:
 
 
 def write_carmen(log: Log, path: str | PathLike[str]) -> None:
-    """Write ``log`` as a CARMEN text log: a ``#`` header, then ``ODOM`` + laser line per scan.
+    """Write ``log`` as a CARMEN text log: a ``#`` header, three ``PARAM`` lines stating the
+    laser's mount, then ``ODOM`` + laser line per scan.
 
     Scans whose bearings follow :func:`flaser_angles` are written as old-format ``FLASER``;
     any other evenly spaced bearings as ``ROBOTLASER1`` (which records start angle and
-    resolution). The poses written are ``log.odometry``; ``log.truth`` is not written (use
-    :func:`fhslam.io.write_trajectory` for it). ``tv``/``rv`` in ``ODOM`` are finite
-    differences of the odometry; ``accel`` is 0.
+    resolution). The poses written are ``log.odometry`` (``ODOM`` and the laser lines'
+    odometry/robot triple) and, as CARMEN's robot module writes it, the laser pose
+    ``log.odometry ⊕ log.laser_offset``; the mount itself goes into ``PARAM
+    robot_frontlaser_offset``, ``robot_frontlaser_side_offset`` and
+    ``robot_frontlaser_angular_offset``, so :func:`read_carmen` gets ``laser_offset`` back
+    exactly. ``log.truth`` is not written (use :func:`fhslam.io.write_trajectory` for it).
+    ``tv``/``rv`` in ``ODOM`` are finite differences of the odometry; ``accel`` is 0.
 
     Parameters
     ----------
@@ -118,29 +237,40 @@ def write_carmen(log: Log, path: str | PathLike[str]) -> None:
     rv[1:][ok] = wrap_angle(step[ok, 2]) / dt[ok]
 
     laser = "FLASER" if use_flaser else "ROBOTLASER1"
+    mount = np.asarray(log.laser_offset, dtype=float)
+    mounted = bool(np.any(mount != 0))
+    laser_poses = compose(odom, mount) if mounted else odom
     header = [
         f"# CARMEN log written by fhslam: {log.name}, {len(log)} scans of {n} beams, "
         f"max range {log.max_range!r} m",
+        "# PARAM param_name param_value ipc_timestamp ipc_hostname logger_timestamp",
         "# ODOM x y theta tv rv accel ipc_timestamp ipc_hostname logger_timestamp",
         "# FLASER num_readings [range_readings] x y theta odom_x odom_y odom_theta "
         "ipc_timestamp ipc_hostname logger_timestamp",
-        f"# {laser} poses are odometry; no ground truth is stored in this file",
+        f"# {laser} poses: the laser's (odometry + mount), then the odometry; "
+        "no ground truth is stored in this file",
+    ]
+    t0 = repr(float(log.timestamps[0])) if len(log) else "0.0"
+    params = [
+        f"PARAM {name} {value!r} {t0} {HOSTNAME} {t0}"
+        for name, value in zip(MOUNT_PARAMS, map(float, mount), strict=True)
     ]
     with atomic_output(path) as f:
-        f.write("\n".join(header) + "\n")
+        f.write("\n".join(header + params) + "\n")
         for k in range(len(log)):
             ts = repr(float(log.timestamps[k]))
             tail = f"{ts} {HOSTNAME} {ts}"
             pose = _fmt(odom[k])
+            poses = f"{_fmt(laser_poses[k])} {pose}"
             f.write(f"ODOM {pose} {_fmt([tv[k], rv[k], 0.0])} {tail}\n")
             ranges = _fmt(log.ranges[k])
             if use_flaser:
-                f.write(f"FLASER {n} {ranges} {pose} {pose} {tail}\n")
+                f.write(f"FLASER {n} {ranges} {poses} {tail}\n")
             else:
                 fov, res = angles[-1] - angles[0], (angles[-1] - angles[0]) / (n - 1)
                 head = _fmt([angles[0], fov, res, log.max_range, 0.01])
                 f.write(
-                    f"ROBOTLASER1 0 {head} 0 {n} {ranges} 0 {pose} {pose} "
+                    f"ROBOTLASER1 0 {head} 0 {n} {ranges} 0 {poses} "
                     f"{_fmt([tv[k], rv[k], 0.0, 0.0, 0.0])} {tail}\n"
                 )
 
@@ -179,7 +309,12 @@ def _check_finite(values: NDArray[np.float64], what: str, where: str) -> None:
         raise CarmenFormatError(f"{where}: non-finite {what} {values.tolist()}")
 
 
-def _parse_flaser(fields: list[str], where: str) -> tuple[float, NDArray, NDArray, None]:
+_Parsed = tuple[float, NDArray, NDArray, NDArray, NDArray | None]
+"""What a laser-line parser returns: ``(ipc_timestamp, ranges, odometry, laser_pose,
+geometry)``; ``geometry`` is ``[start_angle, resolution, max_range]`` or ``None``."""
+
+
+def _parse_flaser(fields: list[str], where: str) -> _Parsed:
     """``FLASER n r_1..r_n x y theta odom_x odom_y odom_theta ipc_ts host logger_ts``."""
     if len(fields) < 2:
         raise CarmenFormatError(f"{where}: truncated FLASER line (no num_readings)")
@@ -202,12 +337,10 @@ def _parse_flaser(fields: list[str], where: str) -> tuple[float, NDArray, NDArra
     _check_finite(poses, "pose", where)
     stamp = _floats([fields[8 + n]], "ipc_timestamp", where)
     _check_finite(stamp, "ipc_timestamp", where)
-    return float(stamp[0]), ranges, poses[3:6], None
+    return float(stamp[0]), ranges, poses[3:6], poses[0:3], None
 
 
-def _parse_robotlaser1(
-    fields: list[str], where: str
-) -> tuple[float, NDArray, NDArray, NDArray[np.float64]]:
+def _parse_robotlaser1(fields: list[str], where: str) -> _Parsed:
     """``ROBOTLASER1`` (see the module docstring); returns the robot pose as odometry.
 
     The remission block ``num_remissions [remissions]`` is optional (older CARMEN versions
@@ -239,14 +372,132 @@ def _parse_robotlaser1(
     _check_finite(poses, "pose", where)
     stamp = _floats([tail[11]], "ipc_timestamp", where)
     _check_finite(stamp, "ipc_timestamp", where)
-    return float(stamp[0]), ranges, poses[3:6], np.array([start, res, max_range])
+    return float(stamp[0]), ranges, poses[3:6], poses[0:3], np.array([start, res, max_range])
+
+
+@dataclass(frozen=True)
+class _Param:
+    value: float
+    lineno: int
+
+
+def _read_param(fields: list[str], where: str, lineno: int, params: dict[str, _Param]) -> None:
+    """Record a ``PARAM name value ...`` line of one of the names this reader uses; ignore
+    every other name (a value may be any string)."""
+    if len(fields) < 2:
+        raise CarmenFormatError(f"{where}: PARAM line without a parameter name")
+    name = fields[1]
+    unit = _UNITS.get(name)
+    if unit is None:
+        return
+    if len(fields) < 3:
+        raise CarmenFormatError(f"{where}: PARAM {name} has no value (a number of {unit})")
+    try:
+        value = float(fields[2])
+    except ValueError:
+        raise CarmenFormatError(
+            f"{where}: PARAM {name} value {fields[2]!r} is not a number (of {unit})"
+        ) from None
+    if not math.isfinite(value):
+        raise CarmenFormatError(f"{where}: PARAM {name} value {fields[2]!r} is not finite")
+    if name in (RESOLUTION_PARAM, FOV_PARAM) and not 0 < value <= 360:
+        raise CarmenFormatError(
+            f"{where}: PARAM {name} {value:g} is not an angle in degrees in (0, 360]"
+        )
+    if name == MOUNT_PARAMS[2] and abs(value) > 2 * math.pi:
+        raise CarmenFormatError(
+            f"{where}: PARAM {name} {value:g} is more than a full turn: CARMEN states it in "
+            "radians, not degrees"
+        )
+    seen = params.get(name)
+    if seen is not None and seen.value != value:
+        raise CarmenFormatError(
+            f"{where}: PARAM {name} {value:g} contradicts line {seen.lineno}, which states "
+            f"{seen.value:g}; a log whose laser changes is not supported"
+        )
+    if seen is None:
+        params[name] = _Param(value, lineno)
+
+
+def _fmt_pose(pose: NDArray) -> str:
+    return f"(x {pose[0]:.6g} m, y {pose[1]:.6g} m, theta {pose[2]:.6g} rad)"
+
+
+def _constant_offset(odometry: NDArray, laser_poses: NDArray) -> NDArray[np.float64] | None:
+    """``relative(odometry, laser_pose)`` if it is one constant over the log (within
+    :data:`MOUNT_TOLERANCE`), else ``None`` (corrected laser poses)."""
+    if np.array_equal(odometry, laser_poses):
+        return np.zeros(3)
+    rel = relative(odometry, laser_poses)
+    dev = rel - rel[0]
+    dev[:, 2] = wrap_angle(dev[:, 2])
+    tol_xy, tol_theta = MOUNT_TOLERANCE
+    if np.abs(dev[:, :2]).max() > tol_xy or np.abs(dev[:, 2]).max() > tol_theta:
+        return None
+    offset = rel[0] + np.median(dev, axis=0)
+    offset[2] = wrap_angle(offset[2])
+    offset[np.abs(offset) < 1e-9] = 0.0  # below any log's print precision: exactly none
+    return offset
+
+
+def _laser_mount(
+    path, kind: str, params: dict[str, _Param], odometry: NDArray, laser_poses: NDArray
+) -> tuple[NDArray[np.float64], str]:
+    """The laser's mount and where it came from (the rule of the module docstring)."""
+    from_poses = _constant_offset(odometry, laser_poses)
+    stated = [params.get(name) for name in MOUNT_PARAMS]
+    if all(p is None for p in stated):
+        if from_poses is not None:
+            return from_poses, "laser pose"
+        return np.zeros(3), "none"
+    from_params = np.array([0.0 if p is None else p.value for p in stated])
+    if from_poses is not None:
+        diff = from_params - from_poses
+        diff[2] = wrap_angle(diff[2])
+        tol_xy, tol_theta = MOUNT_TOLERANCE
+        if np.abs(diff[:2]).max() > tol_xy or abs(diff[2]) > tol_theta:
+            linenos = [str(p.lineno) for p in stated if p is not None]
+            lines = f"line{'s' if len(linenos) > 1 else ''} {', '.join(linenos)}"
+            warnings.warn(
+                f"{path}: PARAM lines ({lines}) state the laser mount "
+                f"{_fmt_pose(from_params)}, but the laser poses of its {kind} lines sit at "
+                f"{_fmt_pose(from_poses)} from the odometry; using the PARAM values",
+                CarmenWarning,
+                stacklevel=3,
+            )
+    return from_params, "PARAM"
+
+
+def _flaser_layout(path, params: dict[str, _Param], n: int, first: int) -> NDArray[np.float64]:
+    """The bearings of the ``FLASER`` scans of ``n`` beams (first line ``first``), from the
+    resolution and field-of-view ``PARAM`` lines if stated (:func:`flaser_angles`)."""
+    res, fov = params.get(RESOLUTION_PARAM), params.get(FOV_PARAM)
+    if res is not None and (n - 1) * res.value > 360.0 + 1e-9:
+        raise CarmenFormatError(
+            f"{path}:{res.lineno}: PARAM {RESOLUTION_PARAM} {res.value:g} degrees gives the "
+            f"{n} beams of the FLASER lines (first: line {first}) a field of view of "
+            f"{(n - 1) * res.value:g} degrees, more than a full turn"
+        )
+    if res is not None and fov is not None:
+        k = fov.value / res.value
+        if not any(math.isclose(k, m, rel_tol=0, abs_tol=1e-6) for m in (n, n - 1)):
+            raise CarmenFormatError(
+                f"{path}:{res.lineno}: PARAM {RESOLUTION_PARAM} {res.value:g} and {FOV_PARAM} "
+                f"{fov.value:g} (line {fov.lineno}) make scans of {k + 1:g} beams (or {k:g} "
+                f"without the last), but the FLASER lines (first: line {first}) hold {n}"
+            )
+    return flaser_angles(
+        n,
+        resolution=None if res is None else res.value,
+        fov=None if fov is None else fov.value,
+    )
 
 
 _PARSERS = {"FLASER": _parse_flaser, "ROBOTLASER1": _parse_robotlaser1}
 
 
 def read_carmen(path: str | PathLike[str], max_range: float | None = None) -> Log:
-    """Read the laser scans and their odometry from a CARMEN text log.
+    """Read the laser scans, their odometry and the laser's mount from a CARMEN text log.
 
     Parameters
     ----------
@@ -264,8 +515,11 @@ def read_carmen(path: str | PathLike[str], max_range: float | None = None) -> Lo
     Log
         ``name`` is the file's stem; ``timestamps`` the ``ipc_timestamp`` of each scan;
         ``odometry`` the ``odom_x odom_y odom_theta`` triple of ``FLASER`` (the
-        ``robot_pose`` of ``ROBOTLASER1``); ``angles`` :func:`flaser_angles` for ``FLASER``,
-        ``start_angle + k * angular_resolution`` for ``ROBOTLASER1``. No truth.
+        ``robot_pose`` of ``ROBOTLASER1``); ``angles`` :func:`flaser_angles` for ``FLASER``
+        (with the log's resolution and field-of-view ``PARAM`` lines, if any),
+        ``start_angle + k * angular_resolution`` for ``ROBOTLASER1``; ``laser_offset`` the
+        laser's mount and ``laser_offset_source`` where it came from, ``"PARAM"``,
+        ``"laser pose"`` or ``"none"`` (the rule is in the module docstring). No truth.
 
     Raises
     ------
@@ -274,21 +528,35 @@ def read_carmen(path: str | PathLike[str], max_range: float | None = None) -> Lo
     CarmenFormatError
         ``"{path}:{lineno}: ..."`` for a malformed laser line (truncated, non-numeric field,
         wrong reading count, non-finite pose), a beam count differing from the first scan's,
-        or a file with no laser messages or with both FLASER and ROBOTLASER1.
+        a malformed or contradictory ``PARAM`` of the mount or beam layout, a resolution
+        that spreads the beams over more than 360° (or that contradicts the stated field of
+        view), or a file with no laser messages or with both FLASER and ROBOTLASER1.
+
+    Warns
+    -----
+    CarmenWarning
+        When the ``PARAM`` mount and the constant offset of the laser poses disagree.
     """
     path = input_path(path, "CARMEN log")
     stamps: list[float] = []
     ranges: list[NDArray] = []
     odometry: list[NDArray] = []
+    laser_poses: list[NDArray] = []
+    params: dict[str, _Param] = {}
     first: tuple[str, int, int, NDArray | None] | None = None  # kind, lineno, n, geometry
     try:
         with reading(path), path.open(encoding="utf-8") as f:
             for lineno, line in enumerate(f, start=1):
                 fields = line.split()
-                if not fields or fields[0].startswith("#") or fields[0] not in _PARSERS:
+                if not fields or fields[0].startswith("#"):
+                    continue
+                if fields[0] == "PARAM":
+                    _read_param(fields, f"{path}:{lineno}", lineno, params)
+                    continue
+                if fields[0] not in _PARSERS:
                     continue
                 kind, where = fields[0], f"{path}:{lineno}"
-                stamp, r, odom, geom = _PARSERS[kind](fields, where)
+                stamp, r, odom, laser_pose, geom = _PARSERS[kind](fields, where)
                 if first is None:
                     first = (kind, lineno, len(r), geom)
                     if len(r) == 0:
@@ -311,24 +579,29 @@ def read_carmen(path: str | PathLike[str], max_range: float | None = None) -> Lo
                 stamps.append(stamp)
                 ranges.append(r)
                 odometry.append(odom)
+                laser_poses.append(laser_pose)
     except UnicodeDecodeError as e:
         raise CarmenFormatError(f"{path}: not a CARMEN text log ({e.reason})") from None
     if first is None:
         raise CarmenFormatError(f"{path}: no FLASER or ROBOTLASER1 laser messages found")
 
-    kind, _, n, geom = first
+    kind, first_line, n, geom = first
     r = np.vstack(ranges)
     if kind == "FLASER":
-        angles = flaser_angles(n)
+        angles = _flaser_layout(path, params, n, first_line)
         inferred, _ = effective_max_range(r, None, FLASER_MAX_RANGE)
     else:
         angles = geom[0] + np.arange(n) * geom[1]
         inferred, _ = effective_max_range(r, float(geom[2]), float(geom[2]))
+    odo = np.vstack(odometry)
+    mount, source = _laser_mount(path, kind, params, odo, np.vstack(laser_poses))
     return Log(
         name=path.stem,
         timestamps=np.array(stamps),
         ranges=r,
         angles=angles,
-        odometry=np.vstack(odometry),
+        odometry=odo,
         max_range=inferred if max_range is None else float(max_range),
+        laser_offset=mount,
+        laser_offset_source=source,
     )

@@ -55,6 +55,10 @@ class Log:
         Per-scan offset added to ``angles``, radians (an interlaced laser whose successive
         scans start a quarter of a beam apart, as in the Freiburg hospital log); ``None``:
         every scan uses ``angles``. Read scans through :meth:`scan`.
+    laser_offset_source : str or None
+        Where the reader found ``laser_offset``: for a CARMEN log ``"PARAM"``,
+        ``"laser pose"`` or ``"none"`` (:func:`fhslam.io.read_carmen`), for a bag
+        ``"tf_static"``; ``None``: not recorded (simulated logs).
     """
 
     name: str
@@ -68,6 +72,7 @@ class Log:
     world: Any = None
     laser_offset: NDArray[np.float64] | None = None
     angle_offsets: NDArray[np.float64] | None = None
+    laser_offset_source: str | None = None
 
     def __post_init__(self) -> None:
         self.laser_offset = (

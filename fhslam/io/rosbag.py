@@ -173,6 +173,7 @@ def read_bag(
         max_range=max_range,
         laser_offset=offset,
         angle_offsets=(np.asarray(starts)[order] - a0) if len(layout) > 1 else None,
+        laser_offset_source="tf_static",
     )
 
 

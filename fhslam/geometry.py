@@ -23,6 +23,8 @@ def wrap_angle(a: ArrayLike) -> NDArray[np.float64] | float:
         Angles in radians.
     """
     w = np.pi - np.mod(np.pi - np.asarray(a, dtype=float), TWO_PI)
+    # For a just above pi, np.mod rounds the tiny negative pi - a up to exactly 2 pi: -pi.
+    w = np.where(w <= -np.pi, w + TWO_PI, w)
     return float(w) if np.ndim(w) == 0 else w
 
 
@@ -123,6 +125,8 @@ def normalize_line(rho: ArrayLike, theta: ArrayLike) -> tuple[NDArray, NDArray]:
     neg = rho < 0
     rho = np.where(neg, -rho, rho)
     theta = np.mod(np.where(neg, theta + np.pi, theta), TWO_PI)
+    # np.mod rounds a tiny negative angle up to exactly 2 pi, which is 0.
+    theta = np.where(theta >= TWO_PI, 0.0, theta)
     return rho, theta
 
 

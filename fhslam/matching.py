@@ -2,13 +2,22 @@
 
 Paper, "Match of feature lines": two lines are similar when all four conditions hold:
 
-(a) their observation direction ``dir`` is the same (seen from the same side);
+(a) their observation direction ``dir`` is the same: the robot sees both from the same side;
 (b) the intersection angle of the two lines is below a threshold;
 (c) the distance from the endpoints of one segment to the other line is below a threshold;
 (d) projecting one segment onto the other, the projection has a common part with it.
 
 The tests are made symmetric (``similar(a, b) == similar(b, a)``): (c) takes the largest of
-the four endpoint-to-line distances and (d) the smaller of the two projected overlaps.
+the four endpoint-to-line distances and (d) the smaller of the two projected overlaps. They
+are also invariant under a rigid motion of the frame (lines and pose moved together): each
+is an angle, a distance or a side, never a difference of ``rho`` or ``theta``. For (a) this
+needs care: ``dir`` is measured against the line's own normal, which points away from the
+origin, so two observations of a wall through (or near) the origin can have opposite
+normals and opposite ``dir`` from the same side. The side is therefore compared as the unit
+normal from each line towards the robot, ``-dir n``: (a) holds when
+``dir_a dir_b (n_a . n_b) > 0`` (or the robot lies on both lines, ``dir = 0``). For lines
+whose normals agree, as the paper's lines away from the origin, this is the paper's
+``dir_a == dir_b``.
 
 "Mergence of straight lines" (Fig. 11): the new segment is projected onto the reference
 line, the reference is extended to the union of both extents, and the line is refitted with
@@ -147,7 +156,8 @@ def similarity_matrix(
     params : MatchParams, optional
     pose : array-like, shape (3,), optional
         Robot pose in that frame for the observation directions; without it each line's own
-        ``dir`` is used.
+        ``dir`` is used (each measured against that line's own normal, as
+        :meth:`Line.observed_from` gives it).
 
     Returns
     -------
@@ -159,7 +169,11 @@ def similarity_matrix(
     p = None if pose is None else as_pose(pose)
     a, b = _Segs.of(new), _Segs.of(refs)
     dir_a, dir_b = _directions(a, p, new), _directions(b, p, refs)
-    cos = np.clip(np.abs(a.n @ b.n.T), 0.0, 1.0)
+    dot = a.n @ b.n.T
+    # (a) the robot on the same side of both lines: the normals towards it, -dir n, agree.
+    both_on = (dir_a[:, None] == 0) & (dir_b[None, :] == 0)
+    same_side = dir_a[:, None] * dir_b[None, :] * np.sign(dot) > 0
+    cos = np.clip(np.abs(dot), 0.0, 1.0)
     angle = np.degrees(np.arccos(cos))
     # (c) all four endpoint-to-other-line distances; the largest decides.
     d_ab = np.maximum(np.abs(a.sp @ b.n.T - b.rho), np.abs(a.ep @ b.n.T - b.rho))
@@ -167,7 +181,7 @@ def similarity_matrix(
     distance = np.maximum(d_ab, d_ba)
     overlap = np.minimum(_overlap(a, b), _overlap(b, a).T)
     out = {
-        "same_direction": dir_a[:, None] == dir_b[None, :],
+        "same_direction": same_side | both_on,
         "angle_ok": angle <= params.max_angle_deg,
         "distance_ok": distance <= params.max_distance,
         "overlap_ok": overlap >= params.min_overlap,

@@ -7,7 +7,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from fhslam.geometry import inverse
+from fhslam.geometry import compose, inverse, normalize_line, point_on_line, wrap_angle
 from fhslam.lines import line_from_points
 from fhslam.scan import Scan
 from fhslam.slam.ekf import (
@@ -146,3 +146,89 @@ def test_landmarks_through_the_origin_keep_their_extent():
     assert near_origin  # the two walls through the origin are landmarks
     assert all(ln.length <= 14.5 for ln in near_origin)  # no wall there is longer than 14 m
     assert map_error(r.map, log.world.walls) < 0.05  # was 0.66 m with mirrored extents
+
+
+# ------------------------------------------------------- landmark flips (issue 10)
+
+
+def _started(pose=(0.0, 0.0, 0.0)) -> EKFLineSLAM:
+    slam = EKFLineSLAM()
+    slam.predict(pose)
+    return slam
+
+
+def _stored_landmark(v):
+    """(α, r) stored for the robot-frame line (α_z, r_z) seen from (x, y, θ); v = all five."""
+    a = v[3] + v[2]
+    r, a = normalize_line(v[4] + v[0] * np.cos(a) + v[1] * np.sin(a), a)
+    return np.array([a, r])
+
+
+def test_new_landmark_covariance_matches_finite_differences():
+    """The landmark's covariance with the pose and its own, from the Jacobians of
+    :func:`_stored_landmark`, also where it is stored flipped (r < 0 before the flip)."""
+    rng = np.random.default_rng(7)
+    flips = 0
+    for _ in range(100):
+        v = np.array([*rng.uniform(-8, 8, 2), *rng.uniform(-np.pi, np.pi, 1),
+                      rng.uniform(0, 2 * np.pi), rng.uniform(0.5, 6)])  # fmt: skip
+        a = v[3] + v[2]
+        r_raw = v[4] + v[0] * np.cos(a) + v[1] * np.sin(a)
+        if abs(r_raw) < 0.1:  # too close to the flip for central differences
+            continue
+        flips += r_raw < 0
+        g = np.zeros((2, 5))
+        for k in range(5):
+            d = np.zeros(5)
+            d[k] = 1e-6
+            hi, lo = _stored_landmark(v + d), _stored_landmark(v - d)
+            g[:, k] = [wrap_angle(hi[0] - lo[0]), hi[1] - lo[1]]
+        g /= 2e-6
+        b = rng.normal(size=(3, 3))
+        p0, cz = b @ b.T * 1e-3 + np.eye(3) * 1e-4, np.diag([1e-4, 4e-4])
+        slam = _started()
+        slam.ekf.x, slam.ekf.P = v[:3].copy(), p0.copy()
+        ends = point_on_line(v[4], v[3], np.array([-1.0, 1.0]))
+        slam._add_landmark(line_from_points(ends, rho_theta=(v[4], v[3])), cz)
+        np.testing.assert_allclose(slam.ekf.x[3:], _stored_landmark(v), atol=1e-12)
+        gx, gz = g[:, :3], g[:, 3:]
+        p = slam.ekf.P
+        np.testing.assert_allclose(p[3:, :3], gx @ p0, atol=1e-8)
+        np.testing.assert_allclose(p[3:, 3:], gx @ p0 @ gx.T + gz @ cz @ gz.T, atol=1e-8)
+    assert flips >= 20
+
+
+def test_flipping_a_landmark_to_keep_r_positive_flips_its_covariance():
+    """The same belief stored as (α, r) and as (α + π, −r), with the covariance mapped by
+    J = diag(1, 1, 1, 1, −1), must give the same filter after one update, though only the
+    first one's r turns negative (and is flipped)."""
+    rng = np.random.default_rng(3)
+    b = rng.normal(size=(5, 5))
+    p_a = b @ b.T * 1e-6 + np.diag([1e-6, 1e-6, 1e-6, 1e-4, 1e-4])
+    flip = np.diag([1.0, 1.0, 1.0, 1.0, -1.0])
+    beliefs = [
+        (np.array([1.0, 2.0, 0.0, np.pi / 2, 0.001]), p_a),  # the wall y = 0.001
+        (np.array([1.0, 2.0, 0.0, 3 * np.pi / 2, -0.001]), flip @ p_a @ flip),
+    ]
+    out = []
+    for x, p in beliefs:
+        slam = _started()
+        ends = point_on_line(2.0, 3 * np.pi / 2, np.array([-1.0, 1.0]))
+        slam._add_landmark(line_from_points(ends, rho_theta=(2.0, 3 * np.pi / 2)), np.eye(2))
+        slam.ekf.x, slam.ekf.P = x.copy(), p.copy()
+        # Seen 2.0015 m below the robot at y = 2: the wall is at y = -0.0015, so r < 0.
+        slam._safe_update(np.array([3 * np.pi / 2, 2.0015]), np.diag([1e-6, 1e-6]), [0])
+        out.append((slam.ekf.x.copy(), slam.ekf.P.copy()))
+    (xa, pa), (xb, pb) = out
+    assert xa[3] == pytest.approx(3 * np.pi / 2, abs=0.01) and xa[4] > 0  # the first flipped
+    np.testing.assert_allclose(xa, xb, atol=1e-12)
+    np.testing.assert_allclose(pa, pb, atol=1e-15)
+
+
+def test_the_filter_runs_in_the_frame_of_its_first_pose():
+    slam = EKFLineSLAM(initial_pose=(5.0, -3.0, 1.0))
+    slam.predict((0.0, 0.0, 0.0))  # the odometry frame need not be the world's
+    slam.predict((0.5, 0.0, 0.1))
+    np.testing.assert_allclose(slam.anchor, [5.0, -3.0, 1.0])
+    np.testing.assert_allclose(slam.ekf.x[:3], [0.5, 0.0, 0.1], atol=1e-15)
+    np.testing.assert_allclose(slam.pose, compose([5.0, -3.0, 1.0], [0.5, 0.0, 0.1]), atol=1e-15)

@@ -129,14 +129,12 @@ def test_wrap_angle_returns_a_float_for_scalars_and_keeps_array_shapes():
     assert wrap_angle(np.zeros(0)).shape == (0,)
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="wrap_angle(nextafter(pi, inf)) returns -pi, outside the documented (-pi, pi]: "
-    "np.mod(pi - a, 2 pi) rounds the tiny negative pi - a = -4.4e-16 up to exactly 2 pi",
-)
 def test_wrap_angle_never_returns_minus_pi():
+    """np.mod(pi - a, 2 pi) rounds the tiny negative pi - a = -4.4e-16 up to exactly 2 pi."""
     just_above_pi = np.nextafter(PI, np.inf)
     assert_wrapped(wrap_angle(just_above_pi))
+    assert wrap_angle(just_above_pi) == PI
+    assert_wrapped(wrap_angle(np.array([just_above_pi, -PI, np.nextafter(-PI, -np.inf), 3 * PI])))
 
 
 # --------------------------------------------------------------------------- SE(2) group
@@ -349,14 +347,13 @@ def test_normalize_line_keeps_the_line_and_the_interval_for_arrays():
     np.testing.assert_allclose(dist, 0, atol=TOL)
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="normalize_line(1, -1e-17) returns theta == 2 pi, outside the documented "
-    "[0, 2 pi): np.mod of a tiny negative angle rounds up to exactly 2 pi",
-)
 def test_normalize_line_theta_stays_below_two_pi():
+    """np.mod of a tiny negative angle rounds up to exactly 2 pi: that is theta 0."""
     _, t = normalize_line(1.0, -1e-17)
-    assert 0.0 <= t < 2 * PI
+    assert t == 0.0
+    r, t = normalize_line([1.0, -1.0, 2.0], [-1e-17, np.nextafter(-PI, -np.inf), 2 * PI])
+    assert np.all((t >= 0.0) & (t < 2 * PI))
+    np.testing.assert_array_equal(r, [1.0, 1.0, 2.0])
 
 
 @pytest.mark.parametrize(

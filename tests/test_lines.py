@@ -326,13 +326,9 @@ def test_a_line_seen_from_a_pose_matches_observation_in_the_robot_frame():
         assert seen.rho == pytest.approx(obs.d, abs=1e-11)
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="Line.transformed / transform_lines can return theta == 2 pi, outside the "
-    "documented [0, 2 pi): theta 0.3 turned by -(0.1 + 0.2) sums to -5.6e-17, which "
-    "normalize_line's np.mod rounds up to exactly 2 pi",
-)
 def test_transformed_theta_stays_below_two_pi():
+    """Theta 0.3 turned by -(0.1 + 0.2) sums to -5.6e-17, which np.mod rounds up to exactly
+    2 pi: normalize_line must make that 0."""
     line = line_from_points(points_on(1.0, 0.3, [0.0, 1.0]), rho_theta=(1.0, 0.3))
     pose = [0.0, 0.0, -(0.1 + 0.2)]
     assert_paper_form(line.transformed(pose))

@@ -122,3 +122,88 @@ def test_merging_collinear_segments_is_order_independent_and_idempotent(pieces):
     assert again.rho == pytest.approx(m1.rho, abs=1e-6)
     np.testing.assert_allclose([again.sp, again.ep], [m1.sp, m1.ep], atol=1e-6)
     assert again.n == m1.n + b.n
+
+
+# ------------------------------------------------------------ frame invariance (issue 10)
+
+
+def wall_y0(x0, x1, rho, theta, n=20):
+    """A segment of the wall y ≈ 0 from x0 to x1, as the line (rho, theta) forced on it."""
+    pts = np.column_stack([np.linspace(x0, x1, n), np.zeros(n)])
+    return line_from_points(pts, rho_theta=(rho, theta))
+
+
+def test_wall_through_the_origin_with_opposite_normals_is_similar_from_the_same_side():
+    """Two observations of the wall y ≈ 0 whose normals point opposite ways (theta 90° and
+    270°, rho ≈ 0): the paper's dir differs from the same side, yet the robot sees both
+    from the same side, so condition (a) holds; from opposite sides it does not."""
+    up, down = wall_y0(1, 4, 0.002, np.pi / 2), wall_y0(2, 5, 0.001, 3 * np.pi / 2)
+    above, below = (2.5, 1.5, 0.0), (2.5, -1.5, np.pi)
+    assert up.observed_from(above).dir == -down.observed_from(above).dir  # plain dir differs
+    for pose in (above, below):
+        s = similarity(up, down, pose=pose)
+        assert s.same_direction and s.similar, s
+        assert similarity(down, up, pose=pose).similar
+    # With each line's own dir: seen from the same side or from opposite sides.
+    assert similar(up.observed_from(above), down.observed_from(above))
+    assert similar(up.observed_from(below), down.observed_from(below))
+    s = similarity(up.observed_from(above), down.observed_from(below))
+    assert not s.same_direction and not s.similar
+    assert s.angle_ok and s.distance_ok and s.overlap_ok  # (a) alone says no
+    # The robot between the two (y = 0.002 and y = -0.001): on opposite sides.
+    assert not similarity(up, down, pose=(2.5, 0.0005, 0.0)).same_direction
+    # Lines both with normal 90°, robot on opposite sides of them: still not similar.
+    s = similarity(wall_y0(1, 4, 0.02, np.pi / 2), up, pose=(2.5, 0.01, 0.0))
+    assert not s.same_direction
+
+
+def _scene(rng, k=12):
+    """Reference segments, and new ones that are noisy re-observations of them (some with
+    the opposite normal) or random; all within 4 m of the origin."""
+    refs, new = [], []
+    for _ in range(k):
+        p, ang, length = rng.uniform(-4, 4, 2), rng.uniform(0, 2 * np.pi), rng.uniform(0.5, 3)
+        d = np.array([np.cos(ang), np.sin(ang)])
+        refs.append(seg(*p, *(p + length * d)))
+        q = p + rng.uniform(-0.5, 0.5) * d + rng.normal(0, 0.03, 2)
+        e = ang + rng.normal(0, np.radians(2))
+        a, b = q, q + length * np.array([np.cos(e), np.sin(e)])
+        new.append(seg(*a, *b) if rng.random() < 0.5 else seg(*b, *a))
+    for _ in range(k // 3):
+        p, q = rng.uniform(-4, 4, 2), rng.uniform(-4, 4, 2)
+        new.append(seg(*p, *q))
+    return new, refs
+
+
+def test_similarity_matrix_is_invariant_under_a_rigid_motion():
+    """Lines and robot moved together: the same conditions, the same numbers. Half the
+    motions put one of the lines through the new origin (rho = 0 there)."""
+    from fhslam.geometry import compose, inverse
+    from fhslam.lines import transform_lines
+    from fhslam.matching import similarity_matrix
+
+    rng = np.random.default_rng(2024)
+    n_similar = n_flipped = 0
+    for trial in range(200):
+        new, refs = _scene(rng)
+        pose = np.array([*rng.uniform(-3, 3, 2), rng.uniform(-np.pi, np.pi)])
+        m0 = similarity_matrix(new, refs, pose=pose)
+        if trial % 2:  # the new origin on a reference line
+            ln = refs[rng.integers(len(refs))]
+            on = ln.sp + rng.uniform(0, 1) * (ln.ep - ln.sp)
+            motion = inverse([*on, rng.uniform(-np.pi, np.pi)])
+        else:
+            motion = np.array([*rng.uniform(-20, 20, 2), rng.uniform(-np.pi, np.pi)])
+        new_m, refs_m = transform_lines(new, motion), transform_lines(refs, motion)
+        m1 = similarity_matrix(new_m, refs_m, pose=compose(motion, pose))
+        for key in ("same_direction", "angle_ok", "distance_ok", "overlap_ok", "similar"):
+            assert np.array_equal(m0[key], m1[key]), (trial, key)
+        for key in ("distance", "overlap"):
+            np.testing.assert_allclose(m1[key], m0[key], rtol=0, atol=1e-9)
+        # arccos near 1 turns a last-bit difference of the cosine into ~1e-8 rad.
+        np.testing.assert_allclose(m1["angle_deg"], m0["angle_deg"], rtol=0, atol=1e-5)
+        n_similar += int(m0["similar"].sum())
+        flipped = np.cos(np.subtract.outer([x.theta for x in new_m], [r.theta for r in refs_m]))
+        n_flipped += int((m1["similar"] & (flipped < 0)).sum())
+    assert n_similar >= 1000  # most re-observations match: the test is not vacuous
+    assert n_flipped >= 20  # ... some of them with normals opposite to the reference's

@@ -7,7 +7,7 @@ import json
 import numpy as np
 import pytest
 
-from fhslam.geometry import point_segment_distance
+from fhslam.geometry import compose, inverse, line_through, point_segment_distance, wrap_angle
 from fhslam.sim import (
     LaserParams,
     OdometryNoise,
@@ -16,13 +16,16 @@ from fhslam.sim import (
     add_range_noise,
     beam_angles,
     cast_rays,
+    corridor_world,
     degrade,
+    hall_world,
     load_world,
     odometry_from_truth,
     paper_world,
     random_world,
     route_clearance,
     simulate,
+    transform_world,
 )
 from fhslam.sim.simulate import follow_route, lap_route
 
@@ -219,6 +222,46 @@ def test_random_worlds_differ_and_can_be_driven():
     truth = follow_route(a)
     assert wall_distances(truth[:, :2], a.walls).min() >= 0.3
     assert np.hypot(*(truth[-1, :2] - a.route[-1])) < 0.5
+
+
+@pytest.mark.parametrize("world", [hall_world(), corridor_world()], ids=["hall", "corridor"])
+def test_small_worlds_have_walls_through_the_origin_and_a_clear_loop(world):
+    rho = np.array([line_through(w[:2], w[2:])[0] for w in world.walls])
+    assert (rho < 1e-12).sum() >= 2  # the walls on x = 0 and y = 0
+    assert np.array_equal(world.route[0], world.route[-1])
+    assert wall_distances(dense_route(world), world.walls).min() >= 1.0
+    assert world.route_length == pytest.approx(24.0)
+    assert load_world(world.name).walls.tolist() == world.walls.tolist()
+
+
+MOTIONS = [(5.0, 5.0, 0.0), (-3.3, 2.1, np.radians(37)), (0.0, -15.0, np.pi / 2)]
+
+
+def test_transform_world_moves_walls_route_and_start():
+    w = hall_world()
+    m = np.array([-3.3, 2.1, np.radians(37)])
+    moved = transform_world(w, m)
+    c, s = np.cos(m[2]), np.sin(m[2])
+    rot = np.array([[c, -s], [s, c]])
+    np.testing.assert_allclose(moved.walls[:, :2], w.walls[:, :2] @ rot.T + m[:2], atol=1e-12)
+    np.testing.assert_allclose(moved.walls[:, 2:], w.walls[:, 2:] @ rot.T + m[:2], atol=1e-12)
+    np.testing.assert_allclose(moved.route, w.route @ rot.T + m[:2], atol=1e-12)
+    np.testing.assert_allclose(moved.start, [*(rot @ w.start[:2] + m[:2]), 0.05 + m[2]])
+    assert moved.name == w.name and moved.route_length == pytest.approx(w.route_length)
+    back = transform_world(moved, inverse(m))
+    np.testing.assert_allclose(back.walls, w.walls, atol=1e-12)
+
+
+@pytest.mark.parametrize("world", [hall_world(), corridor_world()], ids=["hall", "corridor"])
+@pytest.mark.parametrize("motion", MOTIONS)
+def test_a_moved_world_gives_the_same_scans_and_the_moved_poses(world, motion):
+    """The premise of tests/test_invariance.py: the noise is drawn in the robot frame, so a
+    moved world gives the very same ranges, and truth and odometry moved with it."""
+    a, b = simulate(world, seed=3), simulate(transform_world(world, motion), seed=3)
+    assert np.array_equal(a.ranges, b.ranges) and np.array_equal(a.hits, b.hits)
+    for got, want in ((b.truth, a.truth), (b.odometry, a.odometry)):
+        d = got - compose(motion, want)
+        assert np.abs(d[:, :2]).max() < 1e-9 and np.abs(wrap_angle(d[:, 2])).max() < 1e-9
 
 
 def test_world_dict_round_trip_and_default_start():

@@ -16,10 +16,13 @@ from fhslam.sim.truth import (
 from fhslam.sim.world import (
     World,
     WorldFormatError,
+    corridor_world,
+    hall_world,
     load_world,
     paper_world,
     random_world,
     route_clearance,
+    transform_world,
 )
 
 __all__ = [
@@ -33,8 +36,10 @@ __all__ = [
     "beam_angles",
     "beam_wall_points",
     "cast_rays",
+    "corridor_world",
     "degrade",
     "follow_route",
+    "hall_world",
     "is_closed_route",
     "lap_route",
     "load_world",
@@ -44,6 +49,7 @@ __all__ = [
     "random_world",
     "route_clearance",
     "simulate",
+    "transform_world",
     "true_lines",
     "visible_wall_points",
 ]

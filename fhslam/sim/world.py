@@ -6,8 +6,11 @@ A world is stored as JSON (see DESIGN.md)::
      "start": [x, y, theta]}
 
 in metres and radians; ``start`` is optional (default: the first waypoint, heading to the
-second). Built-in worlds: ``"paper"`` (:func:`paper_world`, the paper's 18.7 x 14.0 m office)
-and ``"random:SEED"`` (:func:`random_world`, held-out worlds nothing was tuned on).
+second). Built-in worlds: ``"paper"`` (:func:`paper_world`, the paper's 18.7 x 14.0 m office),
+``"random:SEED"`` (:func:`random_world`, held-out worlds nothing was tuned on), and two small
+worlds with walls through the origin, ``"hall"`` (:func:`hall_world`) and ``"corridor"``
+(:func:`corridor_world`). :func:`transform_world` moves a world rigidly (to check that a
+method does not depend on where the world frame lies).
 """
 
 from __future__ import annotations
@@ -19,13 +22,13 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 
 from fhslam.errors import InputError
-from fhslam.geometry import segment_distances, transform_points
+from fhslam.geometry import compose, segment_distances, transform_points
 from fhslam.io.files import input_path, reading
 
-BUILTIN_WORLDS = ("paper", "random:SEED")
+BUILTIN_WORLDS = ("paper", "hall", "corridor", "random:SEED")
 
 
 class WorldFormatError(InputError):
@@ -183,6 +186,32 @@ def _polyline(*points: tuple[float, float]) -> NDArray:
     return np.hstack([p[:-1], p[1:]])
 
 
+def transform_world(world: World, pose: ArrayLike) -> World:
+    """The same world moved rigidly: walls, route and start mapped by ``pose``.
+
+    Parameters
+    ----------
+    world : World
+    pose : array-like, shape (3,)
+        ``new_T_old`` as ``(x, y, theta)``: where the world's old frame lies in the new one.
+
+    Returns
+    -------
+    World
+        Same name; a robot driving it sees exactly the same scans (up to rounding).
+    """
+    p = np.asarray(pose, dtype=float)
+    walls = np.hstack(
+        [transform_points(p, world.walls[:, :2]), transform_points(p, world.walls[:, 2:])]
+    )
+    return World(
+        name=world.name,
+        walls=walls,
+        route=transform_points(p, world.route),
+        start=compose(p, world.start),
+    )
+
+
 # ---------------------------------------------------------------------------- built-ins
 
 
@@ -251,6 +280,49 @@ def paper_world() -> World:
         (17.6, 7.0),  # E
     ]
     return World(name="paper", walls=np.vstack(walls), route=np.array(route, dtype=float))
+
+
+def hall_world() -> World:
+    """A 15 x 15 m pillared hall whose walls run along the axes (origin: south-west corner).
+
+    Sixteen 0.8 m square pillars stand on a 3 m grid (centres 3, 6, 9 and 12 m). The route
+    starts at (1.5, 1.5), a metre and a half from the walls ``y = 0`` and ``x = 0``, which
+    pass through the origin (lines with ``rho = 0``), and drives once round the four
+    south-western pillars (24 m), between the pillars on its north and east legs, keeping at
+    least 1.1 m from every wall. The start heading is 0.05 rad, not the first leg's 0, so
+    that the path's coordinates are not round numbers: from round ones some beams pass
+    exactly through a pillar's corner, and grazing or missing it is then decided by
+    rounding, differently in a moved frame (:func:`transform_world`).
+    """
+    walls = [_polyline((0, 0), (15, 0), (15, 15), (0, 15), (0, 0))]
+    walls += [box_walls(cx, cy, 0.8, 0.8) for cx in (3, 6, 9, 12) for cy in (3, 6, 9, 12)]
+    route = [(1.5, 1.5), (7.5, 1.5), (7.5, 7.5), (1.5, 7.5), (1.5, 1.5)]
+    return World(
+        name="hall", walls=np.vstack(walls), route=np.array(route, dtype=float),
+        start=np.array([1.5, 1.5, 0.05]),
+    )  # fmt: skip
+
+
+def corridor_world() -> World:
+    """A corridor 2 m wide round a 6 x 2 m block, outer walls along the axes (origin: the
+    south-west corner).
+
+    The outer wall is the 10 x 6 m rectangle from the origin, the block spans (2, 2)-(8, 4),
+    and a 0.6 m deep alcove is cut into the outer wall halfway along each long side. The route
+    runs along the corridor's centre line once round the block (24 m), starting at (1, 1)
+    (heading 0.05 rad, for the reason given in :func:`hall_world`): the walls ``y = 0`` and
+    ``x = 0`` pass through the origin.
+    """
+    walls = [
+        _polyline((0, 0), (4.5, 0), (4.5, -0.6), (5.5, -0.6), (5.5, 0), (10, 0), (10, 6)),
+        _polyline((10, 6), (5.5, 6), (5.5, 6.6), (4.5, 6.6), (4.5, 6), (0, 6), (0, 0)),
+        box_walls(5.0, 3.0, 6.0, 2.0),
+    ]
+    route = [(1, 1), (9, 1), (9, 5), (1, 5), (1, 1)]
+    return World(
+        name="corridor", walls=np.vstack(walls), route=np.array(route, dtype=float),
+        start=np.array([1.0, 1.0, 0.05]),
+    )  # fmt: skip
 
 
 def _inside_polygon(p: NDArray, poly: NDArray) -> NDArray[np.bool_]:
@@ -329,7 +401,8 @@ def load_world(name_or_path: str | PathLike[str]) -> World:
     Parameters
     ----------
     name_or_path : str or path-like
-        ``"paper"``, ``"random:SEED"`` (e.g. ``"random:3"``), or the path of a JSON file
+        ``"paper"``, ``"hall"``, ``"corridor"``, ``"random:SEED"`` (e.g. ``"random:3"``),
+        or the path of a JSON file
         ``{"name": ..., "walls": [[x1, y1, x2, y2], ...], "route": [[x, y], ...],
         "start": [x, y, theta]}`` (``start`` optional).
 
@@ -344,8 +417,9 @@ def load_world(name_or_path: str | PathLike[str]) -> World:
     """
     text = str(name_or_path)
     if not isinstance(name_or_path, PathLike):
-        if text == "paper":
-            return paper_world()
+        builtin = {"paper": paper_world, "hall": hall_world, "corridor": corridor_world}
+        if text in builtin:
+            return builtin[text]()
         if text.startswith("random:"):
             seed = text.removeprefix("random:")
             if not seed.isdigit():

@@ -1,7 +1,8 @@
 """EKF line SLAM: the Kalman-filter alternative the paper's introduction lists, as a baseline.
 
 State ``[x, y, θ, α₁, r₁, α₂, r₂, ...]``: the robot pose and each landmark line in Hessian
-form in the world (``r >= 0``). Built on :class:`filterpy.kalman.ExtendedKalmanFilter`:
+form (``r >= 0``), both in the *anchor frame*, the frame of the first pose. Built on
+:class:`filterpy.kalman.ExtendedKalmanFilter`:
 
 - **predict** from the odometry increment ``u = odo_{k-1} ⊖ odo_k`` with a noise model growing
   with the distance and the turn (:class:`EKFParams`);
@@ -15,6 +16,16 @@ form in the world (``r >= 0``). Built on :class:`filterpy.kalman.ExtendedKalmanF
 - **add** unmatched long lines as new landmarks by growing ``x``, ``P`` and the filter's
   dimension — filterpy fixes ``dim_x`` at construction, so :meth:`EKFLineSLAM._grow` builds a
   larger filter and copies the state over; it is the only place the dimension changes.
+
+Where the world frame lies must not matter, yet an EKF is not invariant under a nonlinear
+change of coordinates, and moving the world frame changes each landmark's ``r`` by
+``t · (cos α, sin α)``, nonlinear in ``α``: linearised in the world frame, the filter would
+give another trajectory for another world origin. Its state therefore lives in the anchor
+frame, which the filter's inputs (odometry increments, robot-frame lines) determine alone;
+:attr:`EKFLineSLAM.pose` and :meth:`EKFLineSLAM.landmarks` map it into the world. Keeping
+``r >= 0`` flips a landmark to ``(α + π, −r)`` when an update or its first sighting gives
+``r < 0``: that map is linear, and ``r``'s rows of the covariance and of the Jacobians flip
+sign with it.
 """
 
 from __future__ import annotations
@@ -29,6 +40,7 @@ from fhslam.extraction import ExtractionParams, extract_lines
 from fhslam.geometry import (
     as_pose,
     compose,
+    normalize_line,
     point_on_line,
     position_on_line,
     relative,
@@ -100,11 +112,8 @@ def predict_measurement(x: NDArray, j: int) -> NDArray[np.float64]:
     """ẑ of landmark ``j`` seen from the robot state ``x[:3]``: ``[α − θ, r − (x cos α +
     y sin α)]``, flipped to ``[α − θ + π, −r̂]`` when ``r̂ < 0``; the angle wrapped to [0, 2π)."""
     a, r = x[3 + 2 * j], x[4 + 2 * j]
-    rr = r - (x[0] * np.cos(a) + x[1] * np.sin(a))
-    za = a - x[2]
-    if rr < 0:
-        za, rr = za + np.pi, -rr
-    return np.array([np.mod(za, 2 * np.pi), rr])
+    rr, za = normalize_line(r - (x[0] * np.cos(a) + x[1] * np.sin(a)), a - x[2])
+    return np.array([za, rr])
 
 
 def measurement_jacobian(x: NDArray, j: int) -> NDArray[np.float64]:
@@ -170,11 +179,16 @@ class _MotionEKF(ExtendedKalmanFilter):
 
 
 class EKFLineSLAM:
-    """EKF line SLAM on filterpy, driven like :class:`fhslam.slam.FastHoughSLAM`."""
+    """EKF line SLAM on filterpy, driven like :class:`fhslam.slam.FastHoughSLAM`.
+
+    ``ekf.x`` and ``ekf.P`` are in the anchor frame, the first pose's (see the module docs);
+    :attr:`anchor` is that pose in the world.
+    """
 
     def __init__(self, params: EKFParams | None = None, initial_pose: ArrayLike | None = None):
         self.params = params or EKFParams()
         self.ekf: _MotionEKF | None = None
+        self.anchor: NDArray[np.float64] | None = None
         self._init_pose = None if initial_pose is None else as_pose(initial_pose)
         self._last_odometry: NDArray | None = None
         self._ends: list[NDArray] = []  # per landmark: its two extreme observed points (2, 2)
@@ -182,15 +196,17 @@ class EKFLineSLAM:
 
     @property
     def pose(self) -> NDArray[np.float64]:
-        return self.ekf.x[:3].copy()
+        """The robot pose in the world frame."""
+        return compose(self.anchor, self.ekf.x[:3])
 
     @property
     def n_landmarks(self) -> int:
         return 0 if self.ekf is None else (self.ekf.dim_x - 3) // 2
 
     def _start(self, pose: NDArray) -> None:
+        self.anchor = pose.astype(float).copy()
         self.ekf = _MotionEKF(dim_x=3, dim_z=2)
-        self.ekf.x = pose.astype(float).copy()
+        self.ekf.x = np.zeros(3)  # the anchor frame's origin
         self.ekf.P = np.eye(3) * 1e-9  # "suppose the initial localization is correct"
 
     def _grow(self, landmark: NDArray, cov_rows: NDArray, cov_lm: NDArray) -> None:
@@ -304,24 +320,25 @@ class EKFLineSLAM:
             return
         self.ekf.x[2] = wrap_angle(self.ekf.x[2])
         lm = self.ekf.x[3:].reshape(-1, 2)
-        neg = lm[:, 1] < 0  # keep r >= 0: (α, r) == (α + π, −r)
-        lm[neg, 0] += np.pi
-        lm[neg, 1] *= -1
-        lm[:, 0] = np.mod(lm[:, 0], 2 * np.pi)
+        rows = 4 + 2 * np.flatnonzero(lm[:, 1] < 0)
+        lm[:, 1], lm[:, 0] = normalize_line(lm[:, 1], lm[:, 0])  # keep r >= 0
+        # (α, r) -> (α + π, −r) is linear: the flipped r's covariances change sign.
+        self.ekf.P[rows, :] *= -1.0
+        self.ekf.P[:, rows] *= -1.0
 
     def _add_landmark(self, ln: Line, cov_z: NDArray) -> None:
+        """Append the robot-frame line ``ln`` (covariance ``cov_z`` of its ``(α, r)``) as a
+        landmark, with its covariance from the Jacobians of ``(α, r) = (α_z + θ, r_z + x cos α
+        + y sin α)`` by the pose (``gx``) and by the measurement (``gz``)."""
         x, y, th = self.ekf.x[:3]
         a = ln.theta + th
         r = ln.rho + x * np.cos(a) + y * np.sin(a)
-        flip = r < 0
-        if flip:
-            a, r = a + np.pi, -r
-        a = np.mod(a, 2 * np.pi)
-        dr_dth = -x * np.sin(a) + y * np.cos(a)
-        if flip:
-            dr_dth = -dr_dth
-        gx = np.array([[0.0, 0.0, 1.0], [np.cos(a), np.sin(a), dr_dth]])
-        gz = np.array([[1.0, 0.0], [dr_dth, -1.0 if flip else 1.0]])
+        dr_da = -x * np.sin(a) + y * np.cos(a)  # ∂r/∂θ = ∂r/∂α_z
+        gx = np.array([[0.0, 0.0, 1.0], [np.cos(a), np.sin(a), dr_da]])
+        gz = np.array([[1.0, 0.0], [dr_da, 1.0]])
+        if r < 0:  # stored as (α + π, −r): r's rows flip sign
+            gx[1], gz[1] = -gx[1], -gz[1]
+        r, a = normalize_line(r, a)
         p = self.ekf.P
         rows = gx @ p[:3, :]
         cov_lm = gx @ p[:3, :3] @ gx.T + gz @ cov_z @ gz.T
@@ -333,9 +350,9 @@ class EKFLineSLAM:
     def _extend(self, j: int, ln: Line) -> None:
         """Grow landmark j's seen extent with the observed segment (for the map output).
 
-        The extremes are kept as world points, not as coordinates along the line: a landmark
-        through the origin (r ≈ 0) flips between (α, r) and (α + π, −r), which would reverse
-        such coordinates.
+        The extremes are kept as points (anchor frame), not as coordinates along the line: a
+        landmark through the origin (r ≈ 0) flips between (α, r) and (α + π, −r), which would
+        reverse such coordinates.
         """
         w = ln.transformed(self.ekf.x[:3])
         pts = np.vstack([self._ends[j], w.sp, w.ep])
@@ -354,7 +371,7 @@ class EKFLineSLAM:
         return StepResult(self.pose, len(lines), matched, added, matched > 0, lines)
 
     def landmarks(self) -> list[Line]:
-        """The map: each landmark line over the extent it was seen."""
+        """The map, world frame: each landmark line over the extent it was seen."""
         out = []
         for j in range(self.n_landmarks):
             a, r = self.ekf.x[3 + 2 * j : 5 + 2 * j]
@@ -362,7 +379,7 @@ class EKFLineSLAM:
             sp, ep = point_on_line(r, a, np.array([lo, hi]))
             out.append(
                 Line(rho=float(r), theta=float(a), n=self._support[j], length=float(hi - lo),
-                     sp=sp, ep=ep)
+                     sp=sp, ep=ep).transformed(self.anchor)
             )  # fmt: skip
         return out
 

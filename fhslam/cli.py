@@ -254,11 +254,12 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument(
         "--method",
         choices=("fht", "graph", "classical", "ekf", "odometry"),
-        default="fht",
-        help="fht: fast-Hough SLAM, the paper's procedure (default); graph: the same as the "
-        "front end of a pose graph with scan-matched keyframes and loop closures (for long "
-        "real logs such as intel); classical: fht with OpenCV's classical Hough as Loop 1; "
-        "ekf: EKF line SLAM (filterpy); odometry: dead reckoning",
+        default="graph",
+        help="graph (default): pose-graph SLAM with scan-to-map tracking, verified loop "
+        "closures and a map of fast Hough lines, the same defaults for every log; fht: "
+        "fast-Hough SLAM, the paper's step-by-step procedure; baselines: classical (fht "
+        "with OpenCV's classical Hough as Loop 1), ekf (EKF line SLAM, filterpy), odometry "
+        "(dead reckoning)",
     )
     p.add_argument("--trajectory", required=True, type=Path, help="output: timestamp x y theta")
     p.add_argument("--map", type=Path, help="output map JSON (reference lines)")

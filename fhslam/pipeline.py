@@ -77,8 +77,8 @@ METHODS: dict[str, Method] = {
             "graph",
             GraphSlamParams,
             GraphFastHoughSLAM,
-            "FH-SLAM as the front end of a pose graph with scan-matched keyframes and loop "
-            "closures, for long real logs",
+            "the default: pose-graph SLAM with scan-to-map tracking, information-weighted "
+            "edges, verified loop closures and a map of fast Hough lines",
         ),
         Method(
             "classical",
@@ -153,9 +153,10 @@ def run_backend(backend: Backend, log: Log, progress: bool = False, desc: str = 
 
 
 def run_slam(
-    log: Log, method: str = "fht", params: object | None = None, progress: bool = False
+    log: Log, method: str = "graph", params: object | None = None, progress: bool = False
 ) -> SlamResult:
-    """Run a SLAM method (a key of :data:`METHODS`) over a log.
+    """Run a SLAM method (a key of :data:`METHODS`) over a log: by default the package's
+    SLAM (``"graph"``), with the same defaults for every log.
 
     Every method starts at the first odometry pose, which a simulated log sets to the true
     start ("suppose the initial localization of mobile robot is correct").
@@ -164,8 +165,9 @@ def run_slam(
     ----------
     log : Log
     method : str
-        ``"fht"`` (the paper's procedure), ``"graph"``, ``"classical"``, ``"ekf"`` or
-        ``"odometry"``.
+        ``"graph"`` (default: pose-graph SLAM with scan-to-map tracking, verified loop
+        closures and a fast Hough line map), ``"fht"`` (the paper's procedure), or the
+        baselines ``"classical"``, ``"ekf"``, ``"odometry"``.
     params : optional
         The method's parameters: :class:`SlamParams` (``fht``, ``classical``),
         :class:`GraphSlamParams` (``graph``), :class:`EKFParams` (``ekf``), none

@@ -57,6 +57,20 @@ def _errors_and_jacobians(x, i, j, z):
     return e, ji, jj
 
 
+def _information_matrices(information: ArrayLike, ne: int) -> NDArray[np.float64]:
+    om = np.asarray(information, dtype=float)
+    if (om.ndim == 2 and om.shape[1:] == (3,)) or om.size == 0:
+        om = om.reshape(-1, 3)
+        return om[:, :, None] * np.eye(3)
+    if om.shape[1:] != (3, 3):
+        raise ValueError(f"information must have shape (E, 3) or (E, 3, 3), got {om.shape}")
+    return om
+
+
+def _chi2(e: NDArray[np.float64], om: NDArray[np.float64]) -> NDArray[np.float64]:
+    return np.einsum("ea,eab,eb->e", e, om, e)
+
+
 def _blocks(p, q, b):
     rows = np.broadcast_to(3 * p[:, None, None] + _R3[None, :, None], b.shape)
     cols = np.broadcast_to(3 * q[:, None, None] + _R3[None, None, :], b.shape)
@@ -83,8 +97,9 @@ def optimize(
         Edge endpoints.
     z : array-like, shape (E, 3)
         Measured relative poses ``⊖x_i ⊕ x_j``.
-    information : array-like, shape (E, 3)
-        Diagonal of each edge's information matrix (1 / sigma², in 1/m² and 1/rad²).
+    information : array-like, shape (E, 3) or (E, 3, 3)
+        Each edge's information matrix (symmetric, positive semi-definite; the translation
+        part in the frame of ``z``), or its diagonal (1 / sigma², in 1/m² and 1/rad²).
     robust : array-like, shape (E,), optional
         Cauchy kernel scale per edge in units of the Mahalanobis distance (0: plain least
         squares). An edge whose ``e^T Ω e`` is ``c²`` gets half weight.
@@ -102,7 +117,7 @@ def optimize(
     i = np.asarray(i, dtype=np.intp)
     j = np.asarray(j, dtype=np.intp)
     z = np.asarray(z, dtype=float).reshape(-1, 3)
-    om = np.asarray(information, dtype=float).reshape(-1, 3)
+    om = _information_matrices(information, len(i))
     n, ne = len(x), len(i)
     if not len(j) == len(z) == len(om) == ne:
         raise ValueError(
@@ -119,11 +134,10 @@ def optimize(
         w = np.ones(ne)
         m = c > 0
         if m.any():
-            chi2 = np.sum(om[m] * e[m] * e[m], axis=1)
-            w[m] = 1.0 / (1.0 + chi2 / c[m] ** 2)
-        o = om * w[:, None]
-        jit_o = ji.transpose(0, 2, 1) * o[:, None, :]
-        jjt_o = jj.transpose(0, 2, 1) * o[:, None, :]
+            w[m] = 1.0 / (1.0 + _chi2(e[m], om[m]) / c[m] ** 2)
+        o = om * w[:, None, None]
+        jit_o = ji.transpose(0, 2, 1) @ o
+        jjt_o = jj.transpose(0, 2, 1) @ o
         hij = jit_o @ jj
         parts = [
             _blocks(i, i, jit_o @ ji),
@@ -168,6 +182,7 @@ class PoseGraph:
         self._info: list[NDArray[np.float64]] = []
         self._robust: list[float] = []
         self._kind: list[str] = []
+        self._active: list[bool] = []
 
     def __len__(self) -> int:
         return len(self._poses)
@@ -199,16 +214,35 @@ class PoseGraph:
         robust: float = 0.0,
         kind: str = "odometry",
     ) -> int:
-        """Add the edge ``i -> j`` (see :func:`optimize`); returns its index."""
+        """Add the edge ``i -> j`` (see :func:`optimize`; ``information``: shape (3,) for a
+        diagonal, or (3, 3)); returns its index."""
         if not (0 <= i < len(self) and 0 <= j < len(self)) or i == j:
             raise ValueError(f"edge {i} -> {j} must join two different nodes of {len(self)}")
         self._i.append(i)
         self._j.append(j)
         self._z.append(np.asarray(z, dtype=float).copy())
-        self._info.append(np.asarray(information, dtype=float).copy())
+        self._info.append(
+            _information_matrices(np.reshape(information, (1, *np.shape(information))), 1)[0]
+        )
         self._robust.append(float(robust))
         self._kind.append(kind)
+        self._active.append(True)
         return len(self._i) - 1
+
+    def is_active(self, e: int) -> bool:
+        """Whether edge ``e`` takes part in :meth:`optimize`."""
+        return self._active[e]
+
+    def set_active(self, e: int, active: bool) -> None:
+        """Switch edge ``e`` on or off (an edge found inconsistent is switched off)."""
+        self._active[e] = bool(active)
+
+    def chi2(self, edges: ArrayLike) -> NDArray[np.float64]:
+        """Squared Mahalanobis errors ``e^T Ω e`` of the given edges at the current poses."""
+        k = np.asarray(edges, dtype=np.intp).reshape(-1)
+        i, j = np.array(self._i, dtype=np.intp)[k], np.array(self._j, dtype=np.intp)[k]
+        z = np.array(self._z).reshape(-1, 3)[k]
+        return _chi2(edge_errors(self.poses, i, j, z), np.array(self._info)[k])
 
     def set_measurement(self, e: int, z: ArrayLike) -> None:
         """Replace edge ``e``'s measurement."""
@@ -225,14 +259,15 @@ class PoseGraph:
         )
 
     def optimize(self, iterations: int = 10, tol: float = 1e-6) -> None:
-        """Optimise all poses in place (node 0 fixed)."""
+        """Optimise all poses in place (node 0 fixed), with the active edges."""
+        a = np.array(self._active, dtype=bool)
         x = optimize(
             self.poses,
-            self._i,
-            self._j,
-            np.array(self._z).reshape(-1, 3),
-            np.array(self._info).reshape(-1, 3),
-            np.array(self._robust),
+            np.array(self._i, dtype=np.intp)[a],
+            np.array(self._j, dtype=np.intp)[a],
+            np.array(self._z).reshape(-1, 3)[a],
+            np.array(self._info).reshape(-1, 3, 3)[a],
+            np.array(self._robust)[a],
             iterations,
             tol,
         )

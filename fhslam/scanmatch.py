@@ -21,29 +21,76 @@ import cv2
 import numpy as np
 from numba import njit
 from numpy.typing import ArrayLike, NDArray
+from scipy.spatial import cKDTree
 
-from fhslam.geometry import as_points, as_pose, transform_points
+from fhslam.geometry import as_points, as_pose, tls_normal_angle, transform_points
 
 __all__ = [
     "LikelihoodGrid",
     "MatchResult",
+    "PointMap",
+    "Refinement",
     "correlative_search",
+    "densify",
     "match_clouds",
+    "refine",
+    "scan_normals",
     "voxel_downsample",
+    "voxel_index",
 ]
 
 
 def voxel_downsample(points: ArrayLike, size: float) -> NDArray[np.float64]:
     """Keep the first point of each ``size`` × ``size`` cell (order preserved)."""
     p = np.asarray(points, dtype=float).reshape(-1, 2)
+    return p[voxel_index(p, size)]
+
+
+def voxel_index(points: ArrayLike, size: float) -> NDArray[np.intp]:
+    """Indices of the first point of each ``size`` × ``size`` cell, increasing."""
+    p = np.asarray(points, dtype=float).reshape(-1, 2)
     if len(p) == 0:
-        return p
+        return np.zeros(0, dtype=np.intp)
     if not size > 0:
         raise ValueError(f"size must be > 0, got {size}")
     k = np.floor(p / size).astype(np.int64)
     k -= k.min(axis=0)
     _, first = np.unique(k[:, 0] * (int(k[:, 1].max()) + 1) + k[:, 1], return_index=True)
-    return p[np.sort(first)]
+    return np.sort(first)
+
+
+def scan_normals(
+    points: ArrayLike, half_window: int = 3, max_gap: float = 0.1, max_gap_per_metre: float = 0.03
+) -> NDArray:
+    """Unit normals of a scan's points (laser frame, beam order) from their beam neighbours.
+
+    Each point's normal is the principal axis of the ``2 half_window + 1`` consecutive points
+    around it, when each lies within ``max_gap + max_gap_per_metre × range`` metres per index
+    step of the point; else
+    (an edge, a jump, clutter) the normal is NaN. Neighbours in beam order lie on the same
+    surface, so a scan's normals stay sharp where a cloud merged from many scans is blurred.
+    """
+    p = as_points(points, "points")
+    n = len(p)
+    out = np.full((n, 2), np.nan)
+    w = 2 * half_window + 1
+    if n < w:
+        return out
+    idx = np.arange(n - w + 1)[:, None] + np.arange(w)  # windows, centre at half_window
+    win = p[idx]
+    centre = win[:, half_window]
+    far = np.hypot(*(win - centre[:, None]).transpose(2, 0, 1))
+    gap = max_gap + max_gap_per_metre * np.hypot(*centre.T)
+    ok = np.all(far <= gap[:, None] * np.abs(np.arange(w) - half_window), axis=1)
+    q = win - win.mean(axis=1, keepdims=True)
+    sxx, syy = (q[..., 0] ** 2).sum(1), (q[..., 1] ** 2).sum(1)
+    sxy = (q[..., 0] * q[..., 1]).sum(1)
+    theta = tls_normal_angle(sxx, syy, sxy)
+    half, mean = np.hypot(0.5 * (sxx - syy), sxy), 0.5 * (sxx + syy)
+    ok &= mean - half <= 0.25**2 * (mean + half)  # spread across under 1/4 of along
+    nrm = np.column_stack([np.cos(theta), np.sin(theta)])
+    out[half_window : n - half_window][ok] = nrm[ok]
+    return out
 
 
 @dataclass(frozen=True)
@@ -244,3 +291,157 @@ def match_clouds(
         grid, qf, g, fw, np.radians(ac if window > 0 else window_deg), np.radians(af), prior
     )
     return MatchResult(pose, s_f, s_c, s_g)
+
+
+def densify(
+    points: ArrayLike,
+    normals: ArrayLike,
+    step: float = 0.02,
+    max_gap: float = 0.1,
+    max_gap_per_metre: float = 0.03,
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """A scan (laser frame, beam order) with points filled in every ``step`` metres between
+    consecutive beams that lie on one surface (closer than ``max_gap + max_gap_per_metre ×
+    range``, as in :func:`scan_normals`); a filled point's normal is its pair's.
+
+    A wall 15 m away is seen by beams 26 cm apart (1° resolution): as points it is a dotted
+    line that a likelihood grid scores low wherever a query point falls between the dots;
+    filled in, it scores as the wall it is.
+    """
+    p = as_points(points, "points")
+    nrm = np.asarray(normals, dtype=float).reshape(-1, 2)
+    if len(p) < 2:
+        return p, nrm
+    d = np.diff(p, axis=0)
+    gap = np.hypot(*d.T)
+    limit = max_gap + max_gap_per_metre * np.hypot(*p[:-1].T)
+    k = np.where(gap <= limit, np.floor(gap / step).astype(np.intp), 0)
+    pair = np.repeat(np.arange(len(d)), k)
+    if len(pair) == 0:
+        return p, nrm
+    t = (np.arange(len(pair)) - np.repeat(np.cumsum(k) - k, k) + 1) / np.repeat(k + 1, k)
+    fill = p[pair] + t[:, None] * d[pair]
+    u = d[pair] / gap[pair, None]
+    return np.vstack([p, fill]), np.vstack([nrm, np.column_stack([-u[:, 1], u[:, 0]])])
+
+
+# -- point-to-line refinement ---------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class PointMap:
+    """A target cloud ready for point-to-line matching: the points that have a normal, and a
+    k-d tree of them. Normals are given (e.g. :func:`scan_normals`; NaN: none) or come from
+    the principal axis of each point's ``k`` nearest neighbours. Points without a normal
+    (clutter, corners: the smaller spread over 1/4 of the larger) are left out, so every
+    query point's nearest neighbour has one."""
+
+    points: NDArray[np.float64]
+    normals: NDArray[np.float64]
+    tree: cKDTree
+
+    @classmethod
+    def build(cls, points: ArrayLike, normals: ArrayLike | None = None, k: int = 6) -> PointMap:
+        """From points and, if known, their normals (:func:`scan_normals`, NaN: none)."""
+        p = as_points(points, "target points")
+        if normals is not None:
+            nrm = np.asarray(normals, dtype=float).reshape(-1, 2)
+            if len(nrm) != len(p):
+                raise ValueError(f"{len(nrm)} normals for {len(p)} points")
+            ok = np.isfinite(nrm[:, 0])
+            return cls(p[ok], nrm[ok], cKDTree(p[ok]))
+        if len(p) < k:
+            raise ValueError(f"a point map needs at least {k} points, got {len(p)}")
+        tree = cKDTree(p)
+        _, nb = tree.query(p, k=k)
+        q = p[nb] - p[nb].mean(axis=1, keepdims=True)
+        sxx, syy, sxy = (
+            (q[..., 0] ** 2).sum(1),
+            (q[..., 1] ** 2).sum(1),
+            (q[..., 0] * q[..., 1]).sum(1),
+        )
+        theta = tls_normal_angle(sxx, syy, sxy)
+        normals = np.column_stack([np.cos(theta), np.sin(theta)])
+        # eigenvalues of the 2x2 scatter: spread across / along the local line
+        half, mean = np.hypot(0.5 * (sxx - syy), sxy), 0.5 * (sxx + syy)
+        ok = mean - half <= 0.25**2 * (mean + half)
+        return cls(p[ok], normals[ok], cKDTree(p[ok]))
+
+
+@dataclass(frozen=True)
+class Refinement:
+    """Result of :func:`refine`: the pose, the information of the point-to-line residuals
+    about it (3 x 3, per squared metre of residual; units 1/m², 1/(m·rad), 1/rad²), the
+    number of query points that found a line and their rms distance to it (metres)."""
+
+    pose: NDArray[np.float64]
+    hessian: NDArray[np.float64]
+    n_matched: int
+    rms: float
+
+
+def refine(
+    target: PointMap,
+    query: ArrayLike,
+    guess: ArrayLike,
+    max_distance: float = 0.1,
+    iterations: int = 10,
+    huber: float = 0.02,
+    min_eigen_ratio: float = 1e-3,
+    prior: tuple[ArrayLike, ArrayLike] | None = None,
+) -> Refinement:
+    """Point-to-line ICP: the pose of ``query`` in ``target``'s frame near ``guess``.
+
+    Each query point is paired with its nearest target point within ``max_distance``; the
+    pose minimises the weighted squared distances of the query points to those points'
+    tangent lines (Gauss-Newton, a fixed number of rounds: Huber weights, tapered to zero at
+    ``max_distance``). Along a direction the pairs do
+    not constrain (a corridor's axis: eigenvalue under ``min_eigen_ratio`` of the largest)
+    the guess is kept; :attr:`Refinement.hessian` tells the caller how little is known
+    there.
+
+    ``prior=(pose, information)`` adds ``(x - pose)ᵀ information (x - pose)`` to the cost
+    (information in the residuals' units, 1/m² per squared metre of residual): where the
+    pairs say nothing, ``pose`` (e.g. the odometry's prediction) is kept instead of the
+    guess. :attr:`Refinement.hessian` holds the pairs' information only.
+    """
+    q0 = as_points(query, "query")
+    x = as_pose(guess, "guess").copy()
+    if prior is not None:
+        prior_pose = as_pose(prior[0], "prior pose")
+        prior_info = np.asarray(prior[1], dtype=float).reshape(3, 3)
+    h = np.zeros((3, 3))
+    n_ok, rms = 0, 0.0
+    for it in range(iterations):
+        q = transform_points(x, q0)
+        d, j = target.tree.query(q, distance_upper_bound=max_distance)
+        ok = d < max_distance
+        d, j, qk = d[ok], j[ok], q[ok]
+        n = target.normals[j]
+        n_ok = len(n)
+        if n_ok < 10:
+            return Refinement(x, np.zeros((3, 3)), n_ok, 0.0)
+        r = np.einsum("ij,ij->i", n, qk - target.points[j])
+        rel = qk - x[:2]
+        jac = np.column_stack([n, n[:, 1] * rel[:, 0] - n[:, 0] * rel[:, 1]])
+        # Huber on the residual, tapered to 0 at max_distance: a pair forming or breaking
+        # at the cut-off changes nothing abruptly
+        w = (
+            np.minimum(1.0, huber / np.maximum(np.abs(r), 1e-12))
+            * (1 - (d / max_distance) ** 2) ** 2
+        )
+        h = (jac * w[:, None]).T @ jac
+        rms = float(np.sqrt(np.mean(r * r)))
+        if it == iterations - 1:
+            break
+        g = (jac * w[:, None]).T @ r
+        if prior is not None:
+            dp = x - prior_pose
+            dp[2] = np.arctan2(np.sin(dp[2]), np.cos(dp[2]))
+            delta = -np.linalg.solve(h + prior_info, g + prior_info @ dp)
+        else:
+            evals, evecs = np.linalg.eigh(h)
+            keep = evals > min_eigen_ratio * max(evals[-1], 1e-12)
+            delta = -(evecs[:, keep] @ ((evecs[:, keep].T @ g) / evals[keep]))
+        x = x + delta  # no early stop: runs that differ in the last bit stay that close
+    return Refinement(x, h, n_ok, rms)

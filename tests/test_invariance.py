@@ -32,7 +32,7 @@ MOTIONS = {
 TOL_M, TOL_RAD = 1e-6, 1e-6
 """Largest difference between the two runs' poses (mapped into one frame). Measured: at most
 2e-13 m and 4e-14 rad for fht, classical and ekf, 3e-12 m and 4e-13 rad for odometry (the
-simulated odometry's own rounding); 1.5-5 cm for graph (see its test)."""
+simulated odometry's own rounding); see the graph test for graph."""
 
 
 @cache
@@ -86,14 +86,18 @@ def test_fh_slam_on_the_hall_in_its_own_frame():
     assert max(abs(ln.ep[1]) for ln in on_y0) <= 0.02
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="graph: the scan matcher's likelihood grid and voxel filters are aligned with the "
-    "world axes (fhslam/scanmatch.py), so a moved world is discretised differently: "
-    "1.5-5 cm apart on the hall",
-)
-def test_graph_trajectory_does_not_depend_on_the_world_frame():
-    own, _, _ = _run("hall", (0.0, 0.0, 0.0), "graph")
-    moved, _, _ = _run("hall", MOTIONS["moved (5, 5)"], "graph")
+@pytest.mark.parametrize("motion", MOTIONS.values(), ids=MOTIONS.keys())
+@pytest.mark.parametrize("world", ["hall", "corridor"])
+def test_graph_trajectory_does_not_depend_on_the_world_frame(world, motion):
+    """The default method runs in its first pose's frame: its grids and voxels are aligned
+    with that frame, not the world's, so a moved world changes only the final composition
+    (before, grids aligned with the world's axes made runs differ by 1.5-5 cm)."""
+    own, _, log = _run(world, (0.0, 0.0, 0.0), "graph")
+    moved, _, _ = _run(world, motion, "graph")
     dpos, dth = _pose_difference(moved, own)
-    assert dpos <= TOL_M and dth <= TOL_RAD, f"{dpos:.3g} m, {dth:.3g} rad"
+    # Not 1e-6: the moved world's odometry differs in the last bits (3.8e-13 m), and the
+    # graph's discrete choices (search cells, nearest neighbours) let such differences grow
+    # to millimetres, as another CPU would. Measured at most 7.4 mm and 0.14°.
+    assert dpos <= 0.015 and dth <= np.radians(0.3), f"{dpos:.3g} m, {dth:.3g} rad"
+    assert ate(own, log.truth).rmse <= 0.03  # issue 10's limit for simulated worlds
+    assert ate(moved, log.truth).rmse <= 0.03

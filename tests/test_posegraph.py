@@ -81,3 +81,46 @@ def test_pose_graph_class_and_bad_input():
         optimize(np.zeros((2, 3)), [0], [2], np.zeros((1, 3)), np.ones((1, 3)))
     # a graph without edges is returned unchanged
     np.testing.assert_array_equal(optimize(np.ones((3, 3)), [], [], [], []), np.ones((3, 3)))
+
+
+def test_full_information_matrices_agree_with_diagonals_and_rotate_with_the_edge():
+    truth = _ring()
+    i, j = np.r_[np.arange(11), 0], np.r_[np.arange(1, 12), 11]
+    z = relative(truth[i], truth[j])
+    rng = np.random.default_rng(2)
+    z_noisy = z + rng.normal(scale=[0.02, 0.02, 0.01], size=z.shape)
+    diag = rng.uniform(10, 1000, size=(len(i), 3))
+    a = optimize(truth, i, j, z_noisy, diag, tol=1e-12)
+    b = optimize(truth, i, j, z_noisy, diag[:, :, None] * np.eye(3), tol=1e-12)
+    np.testing.assert_allclose(a, b, atol=1e-12)
+    with pytest.raises(ValueError, match=r"shape \(E, 3\) or \(E, 3, 3\)"):
+        optimize(truth, i, j, z, np.ones((len(i), 2, 2)))
+
+
+def test_an_edge_without_information_along_an_axis_leaves_it_to_the_others():
+    """A corridor's edge: nothing known along x. Its wrong x (1 m) must not move node 1, which
+    a weak second edge places; its y, known well, wins over the weak edge's."""
+    g = PoseGraph()
+    for _ in range(2):
+        g.add_node([0.0, 0.0, 0.0])
+    corridor = np.diag([0.0, 1e6, 1e6])  # the error's x: along the corridor
+    g.add_edge(0, 1, [1.0, 0.0, 0.0], corridor)
+    g.add_edge(0, 1, [2.0, 0.3, 0.0], [1.0, 1.0, 1.0])
+    g.optimize(iterations=10, tol=1e-12)
+    np.testing.assert_allclose(g.poses[1], [2.0, 0.3e-6, 0.0], atol=1e-6)
+
+
+def test_switched_off_edges_take_no_part_and_chi2_measures_the_rest():
+    g = PoseGraph()
+    for _ in range(2):
+        g.add_node([0.0, 0.0, 0.0])
+    good = g.add_edge(0, 1, [1.0, 0.0, 0.0], [100.0, 100.0, 100.0])
+    bad = g.add_edge(0, 1, [1.0, 2.0, 0.0], [100.0, 100.0, 100.0], kind="loop")
+    g.optimize(iterations=10, tol=1e-12)
+    np.testing.assert_allclose(g.poses[1], [1.0, 1.0, 0.0], atol=1e-9)  # the average
+    np.testing.assert_allclose(g.chi2([good, bad]), [100.0, 100.0], rtol=1e-9)
+    g.set_active(bad, False)
+    assert g.is_active(good) and not g.is_active(bad)
+    g.optimize(iterations=10, tol=1e-12)
+    np.testing.assert_allclose(g.poses[1], [1.0, 0.0, 0.0], atol=1e-9)
+    np.testing.assert_allclose(g.chi2([good, bad]), [0.0, 400.0], atol=1e-9)

@@ -102,3 +102,76 @@ def test_likelihood_grid_is_a_function_of_exact_squared_distances():
     d2 = np.rint(distance_transform_edt(occupied) ** 2)
     want = np.exp(-0.5 * d2 * (res / sigma) ** 2).astype(np.float32)
     np.testing.assert_array_equal(grid.values, want)
+
+
+# --------------------------------------------------------------------- point-to-line refine
+
+
+def _scan_of_room(pose, n=361):
+    """Points of ``_room()`` seen from ``pose`` as ordered beams (laser frame), by keeping for
+    each bearing the nearest room point within half a degree of it."""
+    room = transform_points(inverse(np.asarray(pose, float)), _room(0.001))
+    bearing, rng = np.arctan2(room[:, 1], room[:, 0]), np.hypot(*room.T)
+    beams = np.linspace(-np.pi, np.pi, n, endpoint=False)
+    k = np.round((bearing + np.pi) / (2 * np.pi / n)).astype(int) % n
+    best = np.full(n, np.inf)
+    np.minimum.at(best, k, rng)
+    ok = np.isfinite(best)
+    return np.column_stack([best[ok] * np.cos(beams[ok]), best[ok] * np.sin(beams[ok])])
+
+
+def test_scan_normals_are_perpendicular_to_the_walls_and_nan_at_corners():
+    from fhslam.scanmatch import scan_normals
+
+    pts = _scan_of_room([1.0, 3.0, 0.0])
+    nrm = scan_normals(pts)
+    ok = np.isfinite(nrm[:, 0])
+    assert ok.mean() >= 0.7  # measured 0.89: all but corners, the box's edges, scan ends
+    # the valid normals are the room's axes (walls along x and y): 95 % to 1°, all to 10°
+    # (next to a corner a window may still reach round it)
+    off = np.degrees(np.arccos(np.clip(np.abs(nrm[ok]).max(axis=1), 0, 1)))
+    assert np.percentile(off, 95) <= 1.0 and off.max() <= 10.0
+    assert np.isnan(scan_normals(pts[:5])).all()  # too few points for a window
+
+
+@pytest.mark.parametrize("offset", [(0.03, -0.02, 1.0), (-0.05, 0.04, -1.5)])
+def test_refine_recovers_a_small_offset_to_a_millimetre(offset):
+    from fhslam.scanmatch import PointMap, refine, scan_normals
+
+    target = _scan_of_room([1.0, 3.0, 0.0])
+    pose = np.array([0.4, -0.3, 0.2])  # the query scan's pose in the target's frame
+    query = _scan_of_room(compose([1.0, 3.0, 0.0], pose))
+    guess = compose(pose, [offset[0], offset[1], np.radians(offset[2])])
+    r = refine(PointMap.build(target, scan_normals(target)), query, guess)
+    assert np.hypot(*(r.pose[:2] - pose[:2])) <= 0.002
+    assert abs(np.degrees(r.pose[2] - pose[2])) <= 0.05
+    assert r.n_matched >= 0.7 * len(query) and r.rms <= 0.003
+    # a room constrains every direction: the information is positive definite
+    assert np.linalg.eigvalsh(r.hessian).min() > 0
+
+
+def test_refine_in_a_corridor_keeps_the_guess_along_it_and_says_so():
+    from fhslam.scanmatch import PointMap, refine
+
+    x = np.arange(-10, 10, 0.02)
+    walls = np.vstack([np.column_stack([x, np.full_like(x, 1.0)]),
+                       np.column_stack([x, np.full_like(x, -1.0)])])  # fmt: skip
+    normals = np.tile([0.0, 1.0], (len(walls), 1))
+    query = walls[np.abs(walls[:, 0]) < 4][::3]
+    r = refine(PointMap.build(walls, normals), query, [0.3, 0.04, 0.01])
+    assert r.pose[0] == pytest.approx(0.3, abs=1e-9)  # nothing known along the axis
+    assert abs(r.pose[1]) <= 1e-6 and abs(r.pose[2]) <= 1e-6  # across and heading: exact
+    evals = np.linalg.eigvalsh(r.hessian)
+    assert evals[0] <= 1e-9 * evals[-1]  # the axis is the Hessian's null direction
+
+
+def test_point_map_and_refine_bad_input():
+    from fhslam.scanmatch import PointMap, refine
+
+    with pytest.raises(ValueError, match="at least 6 points"):
+        PointMap.build(np.zeros((3, 2)))
+    with pytest.raises(ValueError, match="2 normals for 3 points"):
+        PointMap.build(np.eye(3, 2), np.zeros((2, 2)))
+    pm = PointMap.build(_room())
+    r = refine(pm, _room()[:5], [0.0, 0.0, 0.0])  # too few pairs: the guess, no information
+    assert r.n_matched < 10 and np.array_equal(r.pose, np.zeros(3)) and not r.hessian.any()

@@ -81,7 +81,7 @@ def test_unknown_method_is_a_clear_error(paper_log_small):
 
 
 def test_perfect_odometry_stays_on_the_truth(paper_log_perfect):
-    r = run_slam(paper_log_perfect)
+    r = run_slam(paper_log_perfect, "fht")
     err = np.hypot(*(r.poses[:, :2] - paper_log_perfect.truth[:, :2]).T)
     assert np.sqrt(np.mean(err**2)) < 0.02  # FH-SLAM must not corrupt a correct pose
 
@@ -99,7 +99,7 @@ def _run(name, laps, degraded=False):
     log = simulate(load_world(name), seed=0, odometry=OdometryNoise.drifting(), laps=laps)
     if degraded:
         log = degrade(log, drop_fraction=0.1, clutter_fraction=0.05, seed=1)
-    r = run_slam(log)
+    r = run_slam(log, "fht")
     return {
         "ate": ate(r.poses, log.truth).rmse,
         "odometry_ate": ate(log.odometry, log.truth).rmse,
@@ -140,7 +140,7 @@ def test_laser_mounted_off_the_robot_origin_reports_robot_poses():
     robot_truth = compose(sim.truth, inverse(offset))
     log = replace(sim, odometry=compose(sim.odometry, inverse(offset)), truth=robot_truth,
                   laser_offset=offset)  # fmt: skip
-    with_offset = ate(run_slam(log).poses, robot_truth).rmse
-    ignoring = ate(run_slam(replace(log, laser_offset=None)).poses, robot_truth).rmse
+    with_offset = ate(run_slam(log, "fht").poses, robot_truth).rmse
+    ignoring = ate(run_slam(replace(log, laser_offset=None), "fht").poses, robot_truth).rmse
     assert with_offset < 0.05
     assert with_offset < 0.5 * ignoring  # pretending the laser is at the origin is worse

@@ -47,7 +47,7 @@ def reproduce(out_dir: str | Path = "figures", seed: int = SEED) -> list[Path]:
         "fig11_merging": fig11_merging,
         "fig12_pioneer": fig12_pioneer,
         "fig13_environment_map": lambda: fig13_environment_map(log.world),
-        "fig14_slam_result": lambda: fig14_slam_result(drift_log, run_slam(drift_log)),
+        "fig14_slam_result": lambda: fig14_slam_result(drift_log, run_slam(drift_log, "fht")),
     }
     paths = []
     for name, make in makers.items():

@@ -1,38 +1,38 @@
-"""FH-SLAM on a pose graph: the paper's method made to survive long real logs.
+"""Pose-graph SLAM with a map of fast Hough lines: the package's default method.
 
 On a simulated world the paper's step-by-step calibration keeps the pose within centimetres
-(:mod:`fhslam.slam.fht`). On the Intel Research Lab log (45 minutes, 600 m, the same rooms
-visited again and again) it drifts by metres: every reference line is placed with the pose
-of its time, and nothing ever corrects a line placed wrongly, so the errors stay in the map
-and feed back into the pose. What the real logs need, and this module adds:
+(:mod:`fhslam.slam.fht`). Real logs need more: odometry that glitches (a 85° heading jump
+between two scans), rooms visited again after hundreds of metres, clutter that no straight
+line describes. What this module adds, each measured in the README:
 
-1. **The paper's loops as the front end.** :class:`fhslam.slam.FastHoughSLAM` runs scan by
-   scan (Loops 1-3), giving smooth, locally accurate poses (a few centimetres between
-   scans seconds apart on Intel).
+1. **Scan-to-map tracking** (:mod:`fhslam.slam.tracker`): every scan is placed against the
+   points of the last ``submap_keyframes`` keyframes by an exhaustive correlative search
+   around the odometry prediction, refined point-to-line; a search around the previous pose
+   competes when the odometry looks wrong.
 2. **Keyframes.** Every ``keyframe_distance`` metres or ``keyframe_angle_deg`` degrees of
    travel a keyframe starts; the scans until the next one are attached to it with their
-   front-end poses relative to it, and their points form its cloud.
-3. **Odometry edges by scan-to-submap matching.** When a keyframe is complete, its cloud
-   is matched (:func:`fhslam.scanmatch.match_clouds`, a small window) against the clouds of
-   the previous ``submap_keyframes`` keyframes, refining the front end's relative motion.
-4. **Loop closures.** The completed keyframe is matched against up to ``loop_candidates``
-   old keyframes within ``loop_radius`` of it (a large window, exhaustive search); a match
-   scoring at least ``loop_min_score`` adds a loop edge with a Cauchy kernel, and the graph
-   is re-optimised (:mod:`fhslam.posegraph`).
+   tracked poses relative to it, and their points form its cloud. The keyframe's fast Hough
+   lines (Loop 1) are kept for the map.
+3. **Edges weighted by their information.** An edge between consecutive keyframes carries
+   the point-to-line refinement's information (its 3 x 3 Hessian, scaled to
+   ``edge_points`` independent points of ``edge_sigma``) plus a weak odometry prior; in a
+   corridor the scan constrains nothing along the axis and the edge says so.
+4. **Verified loop closures.** A completed keyframe is matched (correlative search, then
+   point-to-line refinement) against up to ``loop_candidates`` old keyframes near it; the
+   search radius and window grow with the distance travelled since the last closure. A
+   match enters the graph only with a fine score of at least ``loop_min_score`` and at least
+   ``loop_min_pairs`` points on a line within ``loop_max_rms``, with a Cauchy kernel; after each
+   optimisation a closure whose error stays above ``loop_max_chi2`` (Mahalanobis) is
+   switched off and the graph optimised again, so a few wrong closures cannot bend the
+   trajectory.
 5. **The map of reference lines** is built at the end by Loop 2 itself: each keyframe's fast
    Hough lines, placed at its optimised pose, are matched with and merged into the map
-   (Fig. 11), and long unmatched lines are added - the paper's map, from better poses.
+   (Fig. 11) - the paper's map, from better poses.
 
-Each scan's pose is its keyframe's optimised pose composed with the scan's front-end pose
+Each scan's pose is its keyframe's optimised pose composed with the scan's tracked pose
 relative to the keyframe.
 
-Optionally (``GraphSlamParams(predict=True)``) each scan is first matched against the recent
-keyframe clouds and the match replaces a clearly worse odometry increment before the front
-end sees it. This rescues MIT CSAIL (whose odometry heading is poor: 1.40 m → 0.040 m mean
-relation error) but derails Intel at an odometry glitch (0.041 m → 2.1 m), so it is off by
-default: an open problem, shown in notebook 08.
-
-``method="graph"`` in :func:`fhslam.pipeline.run_slam` and ``fhslam slam --method graph`` run it;
+``fhslam slam LOG`` runs it (``method="graph"`` in :func:`fhslam.pipeline.run_slam`);
 ``method="fht"`` stays the paper's procedure.
 """
 
@@ -43,109 +43,132 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from fhslam.extraction import extract_lines
 from fhslam.geometry import as_pose, compose, relative, transform_points
 from fhslam.lines import Line, transform_lines
 from fhslam.posegraph import PoseGraph
 from fhslam.reference_map import ReferenceMap
 from fhslam.scan import Scan
-from fhslam.scanmatch import match_clouds, voxel_downsample
+from fhslam.scanmatch import (
+    PointMap,
+    Refinement,
+    densify,
+    match_clouds,
+    refine,
+    scan_normals,
+    voxel_downsample,
+    voxel_index,
+)
 from fhslam.slam.base import FinalEstimate, StepResult
-from fhslam.slam.fht import FastHoughSLAM, SlamParams
+from fhslam.slam.fht import SlamParams
+from fhslam.slam.tracker import ScanTracker, TrackerParams
 
 __all__ = ["GraphFastHoughSLAM", "GraphSlamParams", "LoopClosure"]
 
 
 @dataclass(frozen=True)
 class GraphSlamParams:
-    """Parameters of :class:`GraphFastHoughSLAM`.
+    """Parameters of :class:`GraphFastHoughSLAM` (see the module docs).
 
     Attributes
     ----------
-    front_end : SlamParams
-        The paper's loops, run scan by scan.
+    tracker : TrackerParams
+        Scan-to-map tracking.
+    lines : SlamParams
+        The paper's Loops 1 and 2: each keyframe's line extraction, and matching and merging
+        of the map of reference lines.
     keyframe_distance : float
         Start a keyframe after this much travel, metres...
     keyframe_angle_deg : float
         ... or this much turning, degrees.
     cloud_max_range : float
-        Points farther than this from the laser (metres) stay out of the clouds.
+        Points farther than this from the laser (metres) are not used.
     cloud_voxel : float
         A keyframe's cloud keeps one point per cell of this size, metres.
     submap_keyframes : int
-        Keyframes in the local submap an odometry edge is matched against.
-    predict : bool
-        Whether to correct the odometry by scan matching before the front end (below).
-    predict_window : float
-        Each scan is first matched against the last two keyframes' clouds (in the front
-        end's frame) within ± this many metres of the odometry prediction...
-    predict_window_deg : float
-        ... and ± this many degrees plus ``predict_turn_fraction`` of the odometry's turn
-        since the last scan; a good match replaces the odometry increment the front end
-        sees (see :meth:`GraphFastHoughSLAM._matched_odometry`).
-    predict_turn_fraction : float
-        See ``predict_window_deg``.
-    predict_min_gain : float
-        The match replaces the odometry only if it raises the coarse score by at least
-        this much over the odometry's own pose: odometry that already fits is kept, and a
-        match that is not clearly better cannot lead the front end astray.
-    odometry_window : float
-        Search window of odometry edges, ± metres...
-    odometry_window_deg : float
-        ... and ± degrees.
-    odometry_min_score : float
-        Below this match score an odometry edge keeps the front end's relative motion.
+        Keyframes in the local map a scan is tracked against.
+    max_doubtful : int
+        A scan the tracker is not sure of (:attr:`fhslam.slam.tracker.Track.sure`) starts
+        no keyframe, unless this many in a row were doubtful (new ground); an edge across a
+        doubtful scan carries only the odometry prior.
+    edge_sigma : float
+        Standard deviation of a point-to-line distance, metres...
+    edge_points : float
+        ... and the number of independent points an edge's information counts: the
+        refinement's Hessian is scaled to ``edge_points / (n · edge_sigma²)``.
     odometry_sigma : (float, float)
-        Standard deviation of an odometry edge: metres, degrees.
+        The odometry prior added to each edge between consecutive keyframes: metres, degrees.
     loop_radius : float
-        Old keyframes within this distance (at the current estimate) are loop candidates.
+        Old keyframes within this distance (at the current estimate) are loop candidates...
+    loop_growth : float
+        ... plus this fraction of the distance travelled since the last closure (the drift
+        since then), up to ``loop_max_radius``.
+    loop_max_radius : float
+        See ``loop_growth``.
     loop_min_gap : int
-        ... if at least this many keyframes older.
+        Candidates are at least this many keyframes older.
     loop_candidates : int
         Nearest candidates tried per keyframe.
     loop_window : float
-        Search window of a loop closure, ± metres...
+        Search window of a loop closure, ± metres (plus ``loop_growth`` of the distance
+        travelled since the last closure, up to ``loop_max_window``)...
+    loop_max_window : float
+        See ``loop_window``.
     loop_window_deg : float
         ... and ± degrees.
     loop_min_score : float
-        Smallest fine-grid score (mean likelihood of the query points, 0..1) accepted.
-    loop_sigma : (float, float)
-        Standard deviation of a loop edge: metres, degrees.
+        Smallest fine-grid score (mean likelihood of the query points, 0..1) accepted...
+    loop_min_pairs : int
+        ... with at least this many query points paired with a line by the refinement...
+    loop_max_rms : float
+        ... at an rms distance of at most this, metres.
     loop_kernel : float
         Cauchy kernel scale of loop edges (Mahalanobis units).
+    loop_max_chi2 : float
+        After an optimisation, a loop edge whose squared Mahalanobis error exceeds this is
+        switched off.
     optimize_iterations : int
         Largest number of Gauss-Newton rounds after a keyframe that closed a loop...
     optimize_tol : float
         ... which stop once no pose moves more than this (metres, radians).
     """
 
-    front_end: SlamParams = field(default_factory=SlamParams)
+    tracker: TrackerParams = field(default_factory=TrackerParams)
+    lines: SlamParams = field(default_factory=SlamParams)
     keyframe_distance: float = 0.5
     keyframe_angle_deg: float = 20.0
     cloud_max_range: float = 20.0
     cloud_voxel: float = 0.02
     submap_keyframes: int = 5
-    predict: bool = False
-    predict_window: float = 0.2
-    predict_window_deg: float = 8.0
-    predict_turn_fraction: float = 0.2
-    predict_min_gain: float = 0.2
-    odometry_window: float = 0.3
-    odometry_window_deg: float = 5.0
-    odometry_min_score: float = 0.2
-    odometry_sigma: tuple[float, float] = (0.02, 0.5)
+    max_doubtful: int = 5
+    edge_sigma: float = 0.03
+    edge_points: float = 25.0
+    odometry_sigma: tuple[float, float] = (0.1, 2.0)
     loop_radius: float = 2.5
+    loop_growth: float = 0.05
+    loop_max_radius: float = 8.0
     loop_min_gap: int = 20
     loop_candidates: int = 2
-    loop_window: float = 1.5
+    loop_window: float = 1.0
+    loop_max_window: float = 3.0
     loop_window_deg: float = 15.0
-    loop_min_score: float = 0.6
-    loop_sigma: tuple[float, float] = (0.05, 1.0)
+    loop_min_score: float = 0.55
+    loop_min_pairs: int = 50
+    loop_max_rms: float = 0.03
     loop_kernel: float = 1.0
-    optimize_iterations: int = 5
+    loop_max_chi2: float = 25.0
+    optimize_iterations: int = 10
     optimize_tol: float = 1e-4
 
     def __post_init__(self) -> None:
-        for name in ("keyframe_distance", "keyframe_angle_deg", "cloud_max_range", "cloud_voxel"):
+        for name in (
+            "keyframe_distance",
+            "keyframe_angle_deg",
+            "cloud_max_range",
+            "cloud_voxel",
+            "edge_sigma",
+            "edge_points",
+        ):
             if not getattr(self, name) > 0:
                 raise ValueError(f"{name} must be > 0, got {getattr(self, name)}")
         if self.submap_keyframes < 1 or self.loop_candidates < 0 or self.loop_min_gap < 1:
@@ -164,16 +187,21 @@ class LoopClosure:
     new: int
     pose: NDArray[np.float64]
     score: float
+    edge: int = -1
+    """Its edge in :attr:`GraphFastHoughSLAM.graph`."""
 
 
-def _information(sigma: tuple[float, float]) -> NDArray[np.float64]:
-    s_xy, s_deg = sigma
-    return np.array([1 / s_xy**2, 1 / s_xy**2, 1 / np.radians(s_deg) ** 2])
+def _rotate_information(h: NDArray[np.float64], theta: float) -> NDArray[np.float64]:
+    """A pose's information ``h`` (translation in the target frame) re-expressed for the
+    pose-graph error, whose translation part is in the frame of the pose itself."""
+    c, s = np.cos(theta), np.sin(theta)
+    b = np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
+    return b.T @ h @ b
 
 
 class GraphFastHoughSLAM:
-    """FH-SLAM with keyframes, scan-to-submap odometry edges and loop closures (see the
-    module docs).
+    """Pose-graph SLAM with scan-to-map tracking, verified loop closures and a map of fast
+    Hough lines (see the module docs).
 
     Parameters
     ----------
@@ -186,153 +214,81 @@ class GraphFastHoughSLAM:
         self, params: GraphSlamParams | None = None, initial_pose: ArrayLike | None = None
     ):
         self.params = params or GraphSlamParams()
-        self.front_end = FastHoughSLAM(self.params.front_end, initial_pose)
+        self.tracker = ScanTracker(self.params.tracker)
         self.graph = PoseGraph()
         self.loops: list[LoopClosure] = []
-        self._kf_front: list[NDArray[np.float64]] = []  # keyframe poses in the front end's frame
+        self._initial = None if initial_pose is None else as_pose(initial_pose, "initial_pose")
+        self.origin: NDArray[np.float64] | None = None
+        """The first scan's pose: the graph runs in its frame (see :meth:`step`)."""
+        self._pose: NDArray[np.float64] | None = None
+        self._last_odometry: NDArray[np.float64] | None = None
+        self._kf_front: list[NDArray[np.float64]] = []  # keyframe poses, tracking frame
         self._clouds: list[NDArray[np.float64]] = []
+        self._normals: list[NDArray[np.float64]] = []  # each cloud point's normal or NaN
         self._kf_lines: list[list[Line]] = []
-        self._odometry_edge: list[int] = [-1]  # per keyframe: the edge from its predecessor
+        self._path: list[float] = []  # distance travelled at each keyframe
+        self._last_loop_path = 0.0
+        self._doubtful = 0  # doubtful scans in a row
+        self._kf_doubt = False  # whether a scan since the last keyframe was doubtful
         self._scan_kf: list[int] = []
         self._scan_rel: list[NDArray[np.float64]] = []
-        self._last_odometry: NDArray[np.float64] | None = None
-        self._corrected: NDArray[np.float64] | None = None
-
-    # -- keyframes -------------------------------------------------------------------------
-    def _new_keyframe(self, front_pose: NDArray[np.float64], lines: list[Line]) -> None:
-        p = self.params
-        n = len(self.graph)
-        if n == 0:
-            self.graph.add_node(front_pose)
-        else:
-            if n >= 2:
-                self._refine_odometry_edge(n - 1)
-            z = relative(self._kf_front[-1], front_pose)
-            self.graph.add_node(compose(self.graph.pose(n - 1), z))
-            self._odometry_edge.append(
-                self.graph.add_edge(n - 1, n, z, _information(p.odometry_sigma))
-            )
-            if n >= 2:
-                self._close_loops(n - 1)
-        self._kf_front.append(front_pose.copy())
-        self._clouds.append(np.zeros((0, 2)))
-        self._kf_lines.append(lines)
-
-    def _submap(self, frame: int, members) -> NDArray[np.float64]:
-        x = self.graph.pose(frame)
-        return np.vstack(
-            [transform_points(relative(x, self.graph.pose(m)), self._clouds[m]) for m in members]
-        )
-
-    def _refine_odometry_edge(self, i: int) -> None:
-        """Match the completed keyframe ``i`` against its predecessors; refine edge i-1 -> i."""
-        p = self.params
-        target = self._submap(i - 1, range(max(0, i - p.submap_keyframes), i))
-        guess = relative(self.graph.pose(i - 1), self.graph.pose(i))
-        m = match_clouds(target, self._clouds[i], guess, p.odometry_window, p.odometry_window_deg)
-        if m.score >= p.odometry_min_score:
-            self.graph.set_measurement(self._odometry_edge[i], m.pose)
-            self.graph.set_pose(i, compose(self.graph.pose(i - 1), m.pose))
-
-    def _close_loops(self, i: int) -> None:
-        p = self.params
-        if p.loop_candidates == 0 or i <= p.loop_min_gap:
-            return
-        poses = self.graph.poses
-        old = poses[: i - p.loop_min_gap + 1]
-        d = np.hypot(old[:, 0] - poses[i, 0], old[:, 1] - poses[i, 1])
-        cands = [
-            int(j)
-            for j in np.argsort(d, kind="stable")[: p.loop_candidates]
-            if d[j] <= p.loop_radius
-        ]
-        if not cands:
-            return
-        query = self._submap(i, range(max(0, i - 2), i + 1))
-        # Right after a loop closure the pose is known well: search a small window only.
-        tracking = bool(self.loops) and self.loops[-1].new == i - 1
-        win, win_deg = (
-            (p.odometry_window, p.odometry_window_deg)
-            if tracking
-            else (p.loop_window, p.loop_window_deg)
-        )
-        closed = False
-        for j in cands[:1] if tracking else cands:
-            target = self._submap(j, range(max(0, j - 3), min(j + 4, i - p.loop_min_gap + 1)))
-            m = match_clouds(target, query, relative(poses[j], poses[i]), win, win_deg)
-            if m.score >= p.loop_min_score:
-                self.graph.add_edge(
-                    j, i, m.pose, _information(p.loop_sigma), p.loop_kernel, kind="loop"
-                )
-                self.loops.append(LoopClosure(j, i, m.pose, m.score))
-                closed = True
-        if closed:
-            self.graph.optimize(p.optimize_iterations, p.optimize_tol)
 
     # -- the per-scan step -----------------------------------------------------------------
     def step(self, scan: Scan | None, odometry: ArrayLike) -> StepResult:
-        """Run the front end on one scan, start a keyframe when due, attach the scan to it;
-        returns the front end's step (its pose in the front end's frame)."""
+        """Track one scan, start a keyframe when due, attach the scan to it; returns the
+        tracked pose (the tracking frame; :meth:`finish` revises every pose)."""
         p = self.params
         odometry = as_pose(odometry, "odometry")
         pts = None if scan is None else scan.points(max_range=p.cloud_max_range)[0]
-        res = self.front_end.step(scan, self._matched_odometry(odometry, pts))
-        pose = res.pose
-        if not self._kf_front or self._keyframe_due(pose):
-            self._new_keyframe(pose, res.lines)
+        track = None
+        if self._pose is None:
+            # Everything inside runs in the first pose's frame, so that where the world frame
+            # lies changes nothing but the final composition (grids and voxels are aligned
+            # with the axes of this frame).
+            self.origin = odometry.copy() if self._initial is None else self._initial.copy()
+            pose = np.zeros(3)
+        else:
+            predicted = compose(self._pose, relative(self._last_odometry, odometry))
+            pose = predicted
+            if pts is not None and len(pts) >= 10:
+                track = self.tracker.track(pts, predicted, self._pose)
+                pose = track.pose
+        self._last_odometry, self._pose = odometry, pose
+        lines: list[Line] = []
+        # A doubtful scan starts no keyframe and adds no points, unless doubt lasts.
+        sure = track is None or track.sure
+        self._doubtful = 0 if sure else self._doubtful + 1
+        self._kf_doubt = self._kf_doubt or not sure
+        new = not self._kf_front or (
+            (sure or self._doubtful >= self.params.max_doubtful) and self._keyframe_due(pose)
+        )
+        if new:
+            if scan is not None:
+                fe = p.lines
+                all_points = scan.points()[0]
+                lines = (
+                    fe.extractor(all_points)
+                    if fe.extractor
+                    else extract_lines(all_points, fe.extraction)
+                )
+            self._new_keyframe(pose, lines, track)
         k = len(self.graph) - 1
         rel = relative(self._kf_front[k], pose)
         self._scan_kf.append(k)
         self._scan_rel.append(rel)
-        if pts is not None and len(pts):
-            cloud = np.vstack([self._clouds[k], transform_points(rel, pts)])
-            self._clouds[k] = voxel_downsample(cloud, p.cloud_voxel)
-        return res
-
-    def _matched_odometry(
-        self, odometry: NDArray[np.float64], pts: NDArray[np.float64] | None
-    ) -> NDArray[np.float64]:
-        """The odometry stream the front end sees: each increment of the wheel odometry
-        replaced by the scan's match against the recent keyframe clouds, when it matches.
-
-        Between two scans a real robot may turn by 10-25° (mit-csail at 5 Hz), and wheel
-        odometry gets turns wrong by several per cent; the front end's line matching only
-        tolerates ``max_angle_deg`` (5°). Matching the points first gives it a prediction
-        within a fraction of a degree.
-        """
-        p = self.params
-        last, self._last_odometry = self._last_odometry, odometry
-        if last is None or self._corrected is None:
-            self._corrected = odometry.copy()
-            return self._corrected
-        inc = relative(last, odometry)
-        fe_pose = self.front_end.pose
-        moved = np.hypot(inc[0], inc[1]) > 1e-3 or abs(inc[2]) > np.radians(0.05)
-        if p.predict and moved and pts is not None and len(pts) >= 10 and self._kf_front:
-            k = len(self._kf_front) - 1
-            target = np.vstack(
-                [
-                    transform_points(self._kf_front[m], self._clouds[m])
-                    for m in range(max(0, k - 1), k + 1)
-                ]
-            )
-            if len(target) >= 10:
-                guess = compose(fe_pose, inc)
-                turn = abs(np.degrees(inc[2]))
-                m = match_clouds(
-                    target,
-                    pts,
-                    guess,
-                    p.predict_window,
-                    p.predict_window_deg + p.predict_turn_fraction * turn,
-                )
-                if (
-                    m.score >= p.odometry_min_score
-                    and m.coarse_score - m.guess_score >= p.predict_min_gain
-                ):
-                    inc = relative(fe_pose, m.pose)
-        self._corrected = compose(self._corrected, inc)
-        return self._corrected
+        if pts is not None and len(pts) and (sure or new):
+            c, s = np.cos(rel[2]), np.sin(rel[2])
+            dense, dense_normals = densify(pts, scan_normals(pts))
+            first = np.argsort(np.isnan(dense_normals[:, 0]), kind="stable")  # keep normals
+            dense, dense_normals = dense[first], dense_normals[first]
+            cloud = np.vstack([self._clouds[k], transform_points(rel, dense)])
+            normals = np.vstack([self._normals[k], dense_normals @ [[c, s], [-s, c]]])
+            keep = voxel_index(cloud, p.cloud_voxel)
+            self._clouds[k], self._normals[k] = cloud[keep], normals[keep]
+        if new:
+            self._update_local_map()
+        matched = track is not None and track.matched
+        return StepResult(compose(self.origin, pose), len(lines), 0, 0, matched, lines)
 
     def _keyframe_due(self, pose: NDArray[np.float64]) -> bool:
         rel = relative(self._kf_front[-1], pose)
@@ -341,33 +297,152 @@ class GraphFastHoughSLAM:
             or abs(np.degrees(rel[2])) >= self.params.keyframe_angle_deg
         )
 
+    def _update_local_map(self) -> None:
+        k = len(self._kf_front) - 1
+        members = range(max(0, k - self.params.submap_keyframes + 1), k + 1)
+        self.tracker.set_map(*self._in_frame(self._kf_front, members))
+
+    def _in_frame(self, poses, members, frame=None):
+        """The clouds and normals of keyframes ``members`` placed at ``poses`` (in the frame
+        of ``frame``, a pose in the same frame, if given)."""
+        pts, nrm = [], []
+        for m in members:
+            x = poses[m] if frame is None else relative(frame, poses[m])
+            c, s = np.cos(x[2]), np.sin(x[2])
+            pts.append(transform_points(x, self._clouds[m]))
+            nrm.append(self._normals[m] @ [[c, s], [-s, c]])
+        return np.vstack(pts), np.vstack(nrm)
+
+    # -- keyframes and edges ---------------------------------------------------------------
+    def _information(self, ref: Refinement | None, theta: float) -> NDArray[np.float64]:
+        """The information of a refined match (see ``edge_sigma``), in the edge's frame."""
+        p = self.params
+        if ref is None or ref.n_matched < 10:
+            return np.zeros((3, 3))
+        h = ref.hessian * (p.edge_points / (ref.n_matched * p.edge_sigma**2))
+        return _rotate_information(h, theta)
+
+    def _new_keyframe(self, pose, lines: list[Line], track) -> None:
+        p = self.params
+        n = len(self.graph)
+        if n == 0:
+            self.graph.add_node(pose)
+            self._path.append(0.0)
+        else:
+            z = relative(self._kf_front[-1], pose)
+            self._path.append(self._path[-1] + float(np.hypot(z[0], z[1])))
+            s_xy, s_deg = p.odometry_sigma
+            info = np.diag([1 / s_xy**2, 1 / s_xy**2, 1 / np.radians(s_deg) ** 2])
+            if track is not None and track.sure and not self._kf_doubt:
+                info = info + self._information(track.refinement, float(pose[2]))
+            self._kf_doubt = False
+            self.graph.add_node(compose(self.graph.pose(n - 1), z))
+            self.graph.add_edge(n - 1, n, z, info)
+            if n >= 2:
+                self._close_loops(n - 1)
+        self._kf_front.append(pose.copy())
+        self._clouds.append(np.zeros((0, 2)))
+        self._normals.append(np.zeros((0, 2)))
+        self._kf_lines.append(lines)
+
+    def _submap(self, frame: int, members) -> tuple[NDArray, NDArray]:
+        """Points and normals of keyframes ``members`` in keyframe ``frame``'s frame."""
+        poses = self.graph.poses
+        return self._in_frame(poses, members, poses[frame])
+
+    def _close_loops(self, i: int) -> None:
+        p = self.params
+        if p.loop_candidates == 0 or i <= p.loop_min_gap:
+            return
+        poses = self.graph.poses
+        old = poses[: i - p.loop_min_gap + 1]
+        drift = p.loop_growth * (self._path[i] - self._last_loop_path)
+        radius = min(p.loop_max_radius, p.loop_radius + drift)
+        d = np.hypot(old[:, 0] - poses[i, 0], old[:, 1] - poses[i, 1])
+        cands = [
+            int(j) for j in np.argsort(d, kind="stable")[: p.loop_candidates] if d[j] <= radius
+        ]
+        if not cands:
+            return
+        query = self._submap(i, range(max(0, i - 2), i + 1))[0]
+        if len(query) < 10:
+            return
+        # Right after a loop closure the pose is known well: search a small window only.
+        tracking = bool(self.loops) and self.loops[-1].new == i - 1
+        win = p.tracker.window if tracking else min(p.loop_max_window, p.loop_window + drift)
+        win_deg = p.tracker.window_deg + 2 if tracking else p.loop_window_deg
+        q_refine = voxel_downsample(query, 0.05)
+        closed = False
+        for j in cands[:1] if tracking else cands:
+            target, normals = self._submap(
+                j, range(max(0, j - 3), min(j + 4, i - p.loop_min_gap + 1))
+            )
+            if len(target) < 10:
+                continue
+            m = match_clouds(target, query, relative(poses[j], poses[i]), win, win_deg)
+            if m.score < p.loop_min_score:
+                continue
+            ref = refine(PointMap.build(target, normals), q_refine, m.pose)
+            if ref.n_matched < p.loop_min_pairs or ref.rms > p.loop_max_rms:
+                continue
+            z = ref.pose if np.hypot(*(ref.pose[:2] - m.pose[:2])) <= 0.05 else m.pose
+            e = self.graph.add_edge(
+                j, i, z, self._information(ref, float(z[2])), p.loop_kernel, kind="loop"
+            )
+            self.loops.append(LoopClosure(j, i, z, m.score, e))
+            closed = True
+        if closed:
+            self._last_loop_path = self._path[i]
+            self._optimize()
+
+    def _optimize(self) -> None:
+        """Optimise; switch off loop edges that stay inconsistent, optimise again."""
+        p = self.params
+        self.graph.optimize(p.optimize_iterations, p.optimize_tol)
+        active = [lc for lc in self.loops if self.graph.is_active(lc.edge)]
+        if not active:
+            return
+        chi2 = self.graph.chi2(np.array([lc.edge for lc in active]))
+        bad = [lc for lc, c in zip(active, chi2, strict=True) if c > p.loop_max_chi2]
+        if bad:
+            for lc in bad:
+                self.graph.set_active(lc.edge, False)
+            self.graph.optimize(p.optimize_iterations, p.optimize_tol)
+
     # -- results ---------------------------------------------------------------------------
+    @property
+    def accepted_loops(self) -> list[LoopClosure]:
+        """The loop closures still in the graph (not switched off as inconsistent)."""
+        return [lc for lc in self.loops if self.graph.is_active(lc.edge)]
+
     @property
     def poses(self) -> NDArray[np.float64]:
         """Every scan's pose so far: its keyframe's graph pose ⊕ its pose relative to it."""
         if not self._scan_kf:
             return np.zeros((0, 3))
-        return compose(self.graph.poses[np.array(self._scan_kf)], np.array(self._scan_rel))
+        local = compose(self.graph.poses[np.array(self._scan_kf)], np.array(self._scan_rel))
+        return compose(self.origin, local)
 
     def finish(self) -> FinalEstimate:
-        """Close the last keyframe (refine its edge, look for loops), optimise, and build the
-        map from the keyframes at their optimised poses; every scan's pose is revised."""
+        """Close the last keyframe (look for loops), optimise, and build the map from the
+        keyframes at their optimised poses; every scan's pose is revised."""
         n = len(self.graph)
         if n >= 2:
-            self._refine_odometry_edge(n - 1)
             self._close_loops(n - 1)
-            self.graph.optimize(self.params.optimize_iterations, self.params.optimize_tol)
+            self._optimize()
         return FinalEstimate(self.build_map(), self.poses)
 
     def build_map(self) -> list[Line]:
         """The map of reference lines from the keyframes' lines at their optimised poses
         (:meth:`fhslam.reference_map.ReferenceMap.update`: the front end's policy, applied
         keyframe by keyframe)."""
-        fe = self.params.front_end
+        fe = self.params.lines
+        if self.origin is None:
+            return []
         refs = ReferenceMap(
             fe.matching, fe.min_reference_length, fe.min_reference_points, fe.max_merge_residual
         )
-        for x, lines in zip(self.graph.poses, self._kf_lines, strict=True):
+        for x, lines in zip(compose(self.origin, self.graph.poses), self._kf_lines, strict=True):
             world = transform_lines(lines, x)
             refs.update(world, refs.associate(world, x))
         return refs.lines

@@ -1,0 +1,207 @@
+"""Scan-to-map tracking: the front end of :mod:`fhslam.slam.graph`.
+
+Each scan is placed against a local map (the points of the last few keyframes) in two
+stages: a correlative search (:func:`fhslam.scanmatch.correlative_search`) over a window
+around the odometry prediction, which cannot be caught by a local minimum, then a
+point-to-line refinement (:func:`fhslam.scanmatch.refine`) from its optimum, which reaches
+millimetres and says how well each direction is constrained.
+
+Real odometry glitches: a heading jump of 30-85° between two scans (MIT CSAIL, Intel), a
+position jump of most of a metre. When the match at the prediction scores below
+``min_score``, or the odometry increment is larger than a robot moves between two scans,
+a second search around the previous pose (the robot stood still) with a wide window
+competes with it; the better score wins. When neither matches, the odometry prediction is
+kept: the fallback. A scan placed with a middling score (under ``sure_score``) is not
+trusted further: the next scan searches widely again, and the graph neither starts a
+keyframe on it nor adds its points to the map.
+
+The local map's grids are built once per keyframe (:meth:`ScanTracker.set_map`), not per
+scan.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+from fhslam.geometry import as_pose
+from fhslam.scanmatch import (
+    LikelihoodGrid,
+    PointMap,
+    Refinement,
+    correlative_search,
+    refine,
+    voxel_downsample,
+)
+
+__all__ = ["ScanTracker", "Track", "TrackerParams"]
+
+
+@dataclass(frozen=True)
+class TrackerParams:
+    """Parameters of :class:`ScanTracker`.
+
+    Attributes
+    ----------
+    resolution : float
+        Cell of the correlative search's likelihood grid, metres (its translation step).
+    sigma : float
+        Width of the grid's likelihood ``exp(-d²/2σ²)``, metres.
+    angle_step_deg : float
+        Heading step of the correlative search, degrees.
+    window : float
+        Search ``± window`` metres around the odometry prediction...
+    window_deg : float
+        ... and ``± window_deg`` degrees plus ``turn_fraction`` of the odometry's turn.
+    turn_fraction : float
+        See ``window_deg``.
+    recovery_window : float
+        The search around the previous pose (see the module docs), ± metres...
+    recovery_window_deg : float
+        ... and ± degrees.
+    max_step : float
+        An odometry increment longer than this (metres)...
+    max_turn_deg : float
+        ... or turning more than this (degrees) also triggers the recovery search.
+    min_score : float
+        A match scoring less (mean likelihood of the scan's points, 0..1) is not used.
+    sure_score : float
+        A match scoring less is used but not *sure* (:attr:`Track.sure`): the next scan's
+        search includes the recovery search, and the caller should not build on it.
+    query_voxel : float
+        The scan is thinned to one point per cell of this size (metres)...
+    max_points : int
+        ... and to at most this many points.
+    refine_distance : float
+        Point-to-line pairs farther apart than this (metres) are not formed.
+    prior_sigma : (float, float)
+        The odometry prediction enters the refinement as a prior of this standard deviation
+        (metres, degrees), relative to a point-to-line residual of ``residual_sigma``: where
+        the scan says nothing (a corridor's axis) the odometry is kept.
+    residual_sigma : float
+        See ``prior_sigma``, metres.
+    """
+
+    resolution: float = 0.05
+    sigma: float = 0.08
+    angle_step_deg: float = 0.5
+    window: float = 0.2
+    window_deg: float = 3.0
+    turn_fraction: float = 0.3
+    recovery_window: float = 0.6
+    recovery_window_deg: float = 45.0
+    max_step: float = 0.4
+    max_turn_deg: float = 25.0
+    min_score: float = 0.45
+    sure_score: float = 0.6
+    query_voxel: float = 0.05
+    max_points: int = 250
+    refine_distance: float = 0.15
+    prior_sigma: tuple[float, float] = (0.05, 10.0)
+    residual_sigma: float = 0.03
+
+    def __post_init__(self) -> None:
+        for name in ("resolution", "sigma", "angle_step_deg", "query_voxel", "refine_distance"):
+            if not getattr(self, name) > 0:
+                raise ValueError(f"TrackerParams.{name} must be > 0, got {getattr(self, name)}")
+        if not 0 <= self.min_score <= 1:
+            raise ValueError(f"TrackerParams.min_score must be in [0, 1], got {self.min_score}")
+
+
+@dataclass(frozen=True)
+class Track:
+    """Where :meth:`ScanTracker.track` placed a scan."""
+
+    pose: NDArray[np.float64]
+    score: float
+    """The correlative score at the chosen pose (0 when nothing matched)."""
+    matched: bool
+    """Whether the pose comes from the map (else: the odometry prediction)."""
+    recovered: bool
+    """Whether the recovery search (around the previous pose) won."""
+    sure: bool
+    """Whether the match scored at least ``sure_score``."""
+    refinement: Refinement | None
+
+
+def _thin(points: NDArray[np.float64], n: int) -> NDArray[np.float64]:
+    if len(points) <= n:
+        return points
+    return points[np.linspace(0, len(points) - 1, n).astype(np.intp)]
+
+
+class ScanTracker:
+    """Places scans in a local map (see the module docs)."""
+
+    def __init__(self, params: TrackerParams | None = None):
+        self.params = params or TrackerParams()
+        self._grid: LikelihoodGrid | None = None
+        self._points: PointMap | None = None
+        self._doubt = False  # the last scan was not placed surely
+
+    def set_map(self, points: NDArray[np.float64], normals: NDArray[np.float64]) -> None:
+        """Use ``points`` (in the tracking frame) with their ``normals`` (NaN: none; see
+        :func:`fhslam.scanmatch.scan_normals`) as the local map from now on."""
+        p = self.params
+        margin = p.recovery_window + 3 * p.sigma
+        pts = voxel_downsample(points, p.resolution / 2)
+        if len(pts) < 10:
+            self._grid = self._points = None
+            return
+        self._grid = LikelihoodGrid.build(pts, p.resolution, p.sigma, margin)
+        self._points = PointMap.build(points, normals)
+
+    def track(
+        self,
+        points: NDArray[np.float64],
+        predicted: NDArray[np.float64],
+        previous: NDArray[np.float64],
+    ) -> Track:
+        """Place a scan (``points`` in the laser frame) near ``predicted`` (the previous pose
+        moved by the odometry increment); ``previous`` is the previous scan's pose."""
+        p = self.params
+        predicted = as_pose(predicted, "predicted")
+        q = _thin(voxel_downsample(points, p.query_voxel), p.max_points)
+        if self._grid is None or len(q) < 10:
+            self._doubt = True
+            return Track(predicted, 0.0, False, False, False, None)
+        step = previous[:2] - predicted[:2]
+        turn = abs(np.degrees(np.angle(np.exp(1j * (predicted[2] - previous[2])))))
+        da = np.radians(p.angle_step_deg)
+        prior = (0.05, 0.05)
+        score, pose = correlative_search(
+            self._grid,
+            q,
+            predicted,
+            p.window,
+            np.radians(p.window_deg + p.turn_fraction * turn),
+            da,
+            prior,
+        )
+        recovered = False
+        doubt, self._doubt = self._doubt, True
+        if doubt or score < p.sure_score or np.hypot(*step) > p.max_step or turn > p.max_turn_deg:
+            s2, pose2 = correlative_search(
+                self._grid,
+                q,
+                as_pose(previous, "previous"),
+                p.recovery_window,
+                np.radians(p.recovery_window_deg),
+                da,
+                prior,
+            )
+            if s2 > score + 0.02:
+                score, pose, recovered = s2, pose2, True
+        if score < p.min_score:
+            return Track(predicted, score, False, False, False, None)
+        s_xy, s_deg = p.prior_sigma
+        info = p.residual_sigma**2 * np.diag([1 / s_xy**2, 1 / s_xy**2, 1 / np.radians(s_deg) ** 2])
+        # after a glitch (recovered) the prediction is wrong: no prior then
+        prior = None if recovered else (predicted, info)
+        ref = refine(self._points, points, pose, p.refine_distance, prior=prior)
+        if ref.n_matched >= 10 and np.hypot(*(ref.pose[:2] - pose[:2])) <= 2 * p.resolution:
+            pose = ref.pose
+        self._doubt = score < p.sure_score
+        return Track(pose, score, True, recovered, not self._doubt, ref)

@@ -48,3 +48,7 @@ def test_tracker_parameters_are_checked():
         TrackerParams(resolution=0.0)
     with pytest.raises(ValueError, match=r"min_score must be in \[0, 1\]"):
         TrackerParams(min_score=2.0)
+    with pytest.raises(ValueError, match="prior_sigma must be two values > 0"):
+        TrackerParams(prior_sigma=(0.05, 0.0))
+    with pytest.raises(ValueError, match="residual_sigma must be > 0"):
+        TrackerParams(residual_sigma=-1.0)

@@ -179,7 +179,7 @@ class GraphSlamParams:
             raise ValueError(f"loop_min_score must be in [0, 1], got {self.loop_min_score}")
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class LoopClosure:
     """An accepted loop closure: keyframe ``new`` seen from the older keyframe ``old``."""
 

@@ -106,6 +106,12 @@ class TrackerParams:
         for name in ("resolution", "sigma", "angle_step_deg", "query_voxel", "refine_distance"):
             if not getattr(self, name) > 0:
                 raise ValueError(f"TrackerParams.{name} must be > 0, got {getattr(self, name)}")
+        if not (len(self.prior_sigma) == 2 and all(v > 0 for v in self.prior_sigma)):
+            raise ValueError(
+                f"TrackerParams.prior_sigma must be two values > 0, got {self.prior_sigma}"
+            )
+        if not self.residual_sigma > 0:
+            raise ValueError(f"TrackerParams.residual_sigma must be > 0, got {self.residual_sigma}")
         if not 0 <= self.min_score <= 1:
             raise ValueError(f"TrackerParams.min_score must be in [0, 1], got {self.min_score}")
 

@@ -57,6 +57,9 @@ class TrackerParams:
         ... and ``± window_deg`` degrees plus ``turn_fraction`` of the odometry's turn.
     turn_fraction : float
         See ``window_deg``.
+    search_prior : (float, float)
+        Score given up per metre and per radian of distance from the prediction in that
+        search: of near-equal scores (a corridor's axis) the one nearest the prediction wins.
     recovery_window : float
         The search around the previous pose (see the module docs), ± metres...
     recovery_window_deg : float
@@ -90,6 +93,7 @@ class TrackerParams:
     window: float = 0.2
     window_deg: float = 3.0
     turn_fraction: float = 0.3
+    search_prior: tuple[float, float] = (0.5, 0.05)
     recovery_window: float = 0.6
     recovery_window_deg: float = 45.0
     max_step: float = 0.4
@@ -176,7 +180,6 @@ class ScanTracker:
         step = previous[:2] - predicted[:2]
         turn = abs(np.degrees(np.angle(np.exp(1j * (predicted[2] - previous[2])))))
         da = np.radians(p.angle_step_deg)
-        prior = (0.05, 0.05)
         score, pose = correlative_search(
             self._grid,
             q,
@@ -184,7 +187,7 @@ class ScanTracker:
             p.window,
             np.radians(p.window_deg + p.turn_fraction * turn),
             da,
-            prior,
+            p.search_prior,
         )
         recovered = False
         doubt, self._doubt = self._doubt, True
@@ -196,7 +199,7 @@ class ScanTracker:
                 p.recovery_window,
                 np.radians(p.recovery_window_deg),
                 da,
-                prior,
+                (0.05, 0.05),
             )
             if s2 > score + 0.02:
                 score, pose, recovered = s2, pose2, True
@@ -207,7 +210,7 @@ class ScanTracker:
         # after a glitch (recovered) the prediction is wrong: no prior then
         prior = None if recovered else (predicted, info)
         ref = refine(self._points, points, pose, p.refine_distance, prior=prior)
-        if ref.n_matched >= 10 and np.hypot(*(ref.pose[:2] - pose[:2])) <= 2 * p.resolution:
+        if ref.n_matched >= 10 and np.hypot(*(ref.pose[:2] - pose[:2])) <= p.window:
             pose = ref.pose
         self._doubt = score < p.sure_score
         return Track(pose, score, True, recovered, not self._doubt, ref)

@@ -39,8 +39,8 @@ def test_an_odometry_glitch_is_absorbed(paper_log, extra):
     odometry = ate(log.odometry, log.truth).rmse
     r = run_slam(log, "graph")
     got = ate(r.poses, log.truth).rmse
-    assert odometry > 0.5  # the glitch alone throws dead reckoning off by 0.65-3 m
-    assert got <= max(0.03, 1.5 * clean)  # measured: clean 1.0 cm, glitched 1.0-1.1 cm
+    assert odometry > 0.5  # the glitch alone throws dead reckoning off by 0.65-7.9 m
+    assert got <= max(0.03, 1.5 * clean)  # measured: clean 3.7 cm, glitched 0.8-2.7 cm
 
 
 def test_tracker_parameters_are_checked():

@@ -8,9 +8,22 @@ from __future__ import annotations
 
 import argparse
 import sys
+from collections.abc import Iterator
+from contextlib import contextmanager
 from pathlib import Path
 
 EXIT_BAD_INPUT = 2
+
+SLAM_METHODS = ("fht", "graph", "classical", "ekf", "odometry")
+"""The ``--method`` choices of ``slam`` and ``bench`` (:data:`fhslam.pipeline.METHODS`)."""
+
+PROFILE_TOP = 25
+"""Functions listed by ``--profile``."""
+
+PROFILE_HELP = (
+    f"run under cProfile and print the top {PROFILE_TOP} functions by cumulative time "
+    "(pstats) to stderr after the normal output"
+)
 
 
 def _simulate(args: argparse.Namespace) -> None:
@@ -170,32 +183,90 @@ def _reproduce(args: argparse.Namespace) -> None:
         print(path)
 
 
+@contextmanager
+def _profiling(enabled: bool) -> Iterator[None]:
+    """Run the body under cProfile (if ``enabled``) and, once it has finished without error,
+    print the top :data:`PROFILE_TOP` functions by cumulative time to stderr."""
+    if not enabled:
+        yield
+        return
+    import cProfile
+    import pstats
+
+    profile = cProfile.Profile()
+    profile.enable()
+    try:
+        yield
+    finally:
+        profile.disable()
+    sys.stdout.flush()
+    stats = pstats.Stats(profile, stream=sys.stderr)
+    stats.sort_stats(pstats.SortKey.CUMULATIVE).print_stats(PROFILE_TOP)
+
+
 def _slam(args: argparse.Namespace) -> None:
+    import fhslam.datasets  # noqa: F401  (imported before --profile starts: not what it shows)
     from fhslam.io import write_map, write_trajectory
     from fhslam.pipeline import run_slam
 
-    log = _load(args)
-    result = run_slam(log, args.method, progress=not args.quiet and len(log) > 200)
-    # Everything is computed before anything is written: bad input leaves no half files.
-    write_trajectory(
-        args.trajectory,
-        result.timestamps,
-        result.poses,
-        header=f"fhslam slam --method {args.method} {args.log}: timestamp x y theta",
-    )
-    if args.map is not None:
-        write_map(args.map, result.map)
-    extra = f" and {len(result.map)} map lines to {args.map}" if args.map else ""
-    print(f"wrote {len(result.poses)} poses to {args.trajectory}{extra}")
+    with _profiling(args.profile):
+        log = _load(args)
+        result = run_slam(log, args.method, progress=not args.quiet and len(log) > 200)
+        # Everything is computed before anything is written: bad input leaves no half files.
+        write_trajectory(
+            args.trajectory,
+            result.timestamps,
+            result.poses,
+            header=f"fhslam slam --method {args.method} {args.log}: timestamp x y theta",
+        )
+        if args.map is not None:
+            write_map(args.map, result.map)
+        extra = f" and {len(result.map)} map lines to {args.map}" if args.map else ""
+        print(f"wrote {len(result.poses)} poses to {args.trajectory}{extra}")
 
 
 def _bench(args: argparse.Namespace) -> None:
-    from fhslam.experiments.bench import format_slam_table, format_table, run_bench, run_slam_bench
+    import fhslam.pipeline  # noqa: F401  (imported before --profile starts: not what it shows)
+    from fhslam.datasets import load_log
+    from fhslam.errors import InputError
+    from fhslam.experiments import bench
 
-    rows = run_bench(scans_per_world=args.scans, repeats=args.repeats, progress=not args.quiet)
-    print(format_table(rows))
-    print()
-    print(format_slam_table(run_slam_bench()))
+    for opt, value in (("--scans", args.scans), ("--repeats", args.repeats)):
+        if value is not None and value < 1:
+            raise InputError(f"{opt} must be a positive number, got {value}")
+    if args.log is None:
+        given = [
+            opt
+            for opt, value in (
+                ("--method", args.method),
+                ("--max-range", args.max_range),
+                ("--download", args.download or None),
+            )
+            if value is not None
+        ]
+        if given:
+            raise InputError(f"{', '.join(given)}: only with --log")
+    with _profiling(args.profile):
+        if args.log is None:
+            rows = bench.run_bench(
+                scans_per_world=25 if args.scans is None else args.scans,
+                repeats=9 if args.repeats is None else args.repeats,
+                progress=not args.quiet,
+            )
+            print(bench.format_table(rows))
+            print()
+            print(bench.format_slam_table(bench.run_slam_bench()))
+            return
+        log = load_log(args.log, download=args.download, max_range=args.max_range)
+        if args.scans is not None:
+            log = bench.log_head(log, args.scans)
+        result = bench.run_log_bench(
+            log,
+            args.method or "graph",
+            repeats=1 if args.repeats is None else args.repeats,
+            progress=not args.quiet,
+        )
+        print(bench.format_log_bench(result))
 
 
 def _positive_metres(text: str) -> float:
@@ -253,7 +324,7 @@ def build_parser() -> argparse.ArgumentParser:
     _log_arguments(p)
     p.add_argument(
         "--method",
-        choices=("fht", "graph", "classical", "ekf", "odometry"),
+        choices=SLAM_METHODS,
         default="graph",
         help="graph (default): pose-graph SLAM with scan-to-map tracking, verified loop "
         "closures and a map of fast Hough lines, the same defaults for every log; fht: "
@@ -264,6 +335,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--trajectory", required=True, type=Path, help="output: timestamp x y theta")
     p.add_argument("--map", type=Path, help="output map JSON (reference lines)")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
+    p.add_argument("--profile", action="store_true", help=PROFILE_HELP)
     p.set_defaults(run=_slam)
 
     p = sub.add_parser(
@@ -321,10 +393,57 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--out", default="figures", type=Path, help="output folder (default figures)")
     p.set_defaults(run=_reproduce)
 
-    p = sub.add_parser("bench", help="time and score every line extractor on the same scans")
-    p.add_argument("--scans", type=int, default=25, help="scans per held-out world (default 25)")
-    p.add_argument("--repeats", type=int, default=9, help="timed calls per scan (default 9)")
+    p = sub.add_parser(
+        "bench",
+        help="time and score every line extractor on the same scans; with --log, where a "
+        "SLAM method's time goes on a real log",
+        description=(
+            "Without --log: every line extractor timed and scored on the same scans of "
+            "held-out simulated worlds, then the SLAM methods' steps per second on the paper "
+            "world. With --log: one SLAM method run over that log; prints scans, wall time, "
+            "scans per second and times real time, and per stage (extraction, tracking, "
+            "local map, loop closure, optimisation, map, other; nested stages subtracted) the "
+            "ms per scan, the share of the total and the ratio to a reference measured in the "
+            "same run: the bare cv2.HoughLinesPointSet call on the log's scans, timed before "
+            "and after the run, so that ratios compare across machines."
+        ),
+    )
+    p.add_argument(
+        "--log",
+        help="run the real-log bench on this CARMEN log, ROS bag or dataset name (intel, ...)",
+    )
+    p.add_argument(
+        "--method",
+        choices=SLAM_METHODS,
+        help="with --log: the SLAM method (default graph; stages are measured for graph, fht "
+        "and classical, the total only for ekf and odometry)",
+    )
+    p.add_argument(
+        "--scans",
+        type=int,
+        metavar="N",
+        help="scans per held-out world (default 25); with --log: only the log's first N scans "
+        "(default all)",
+    )
+    p.add_argument(
+        "--repeats",
+        type=int,
+        metavar="R",
+        help="timed calls per scan (default 9); with --log: runs, medians reported (default 1)",
+    )
+    p.add_argument(
+        "--max-range",
+        type=_positive_metres,
+        metavar="M",
+        help="with --log: the laser's maximum range, m (as for slam)",
+    )
+    p.add_argument(
+        "--download",
+        action="store_true",
+        help="with --log: fetch a named dataset into the user cache if no local copy is found",
+    )
     p.add_argument("--quiet", action="store_true", help="no progress bar")
+    p.add_argument("--profile", action="store_true", help=PROFILE_HELP)
     p.set_defaults(run=_bench)
     return parser
 

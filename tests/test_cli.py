@@ -177,6 +177,72 @@ def test_bench_table_has_every_extractor(capsys):
     assert all(float(r[1]) > 0 for r in slam_rows)  # steps per second
 
 
+@pytest.fixture(scope="module")
+def short_clf(tmp_path_factory):
+    """60 scans of the paper world as a CARMEN log."""
+    from fhslam.io import write_carmen
+
+    path = tmp_path_factory.mktemp("bench") / "short.clf"
+    write_carmen(simulate(paper_world(), seed=0, max_scans=60), path)
+    return path
+
+
+def test_bench_on_a_log_prints_the_stage_table(short_clf, capsys):
+    assert main(["bench", "--log", str(short_clf), "--scans", "20", "--quiet"]) == 0
+    out = capsys.readouterr().out
+    assert "short (graph): 20 scans" in out and "scans/s" in out and "real time" in out
+    rows = {ln.split()[0]: ln.split() for ln in out.splitlines() if ln.split()}
+    for stage in ("extraction", "tracking", "optimisation", "map", "other", "total"):
+        assert stage in rows
+    assert "local map" in out and "loop closure" in out
+    assert rows["total"][2] == "100.0%"
+    assert float(rows["total"][1]) >= float(rows["tracking"][1]) >= 0  # ms/scan
+
+
+def test_bench_on_a_log_with_another_method(short_clf, capsys):
+    argv = ["bench", "--log", str(short_clf), "--method", "fht", "--scans", "10", "--quiet"]
+    assert main(argv) == 0
+    out = capsys.readouterr().out
+    assert "short (fht): 10 scans" in out and "association" in out
+
+
+def test_bench_profile_prints_where_the_time_goes(short_clf):
+    r = run("bench", "--log", str(short_clf), "--scans", "20", "--quiet", "--profile")
+    assert r.returncode == 0, r.stderr
+    assert "20 scans" in r.stdout and "cumulative" not in r.stdout
+    assert "Ordered by: cumulative time" in r.stderr and "run_log_bench" in r.stderr
+
+
+def test_slam_profile_prints_where_the_time_goes(short_clf, tmp_path):
+    traj = tmp_path / "t.txt"
+    r = run("slam", str(short_clf), "--trajectory", str(traj), "--quiet", "--profile")
+    assert r.returncode == 0, r.stderr
+    assert r.stdout.startswith("wrote 60 poses")
+    assert "cumulative" in r.stderr and "run_slam" in r.stderr
+    assert len(read_trajectory(traj)[0]) == 60
+
+
+@pytest.mark.parametrize("scans", ["0", "-5"])
+def test_bench_bad_scans_is_one_line_exit_2(short_clf, scans):
+    for argv in (["bench", "--log", str(short_clf), "--scans", scans], ["bench", "--scans", scans]):
+        r = run(*argv)
+        assert r.returncode == 2 and r.stdout == ""
+        assert r.stderr == f"fhslam: error: --scans must be a positive number, got {scans}\n"
+
+
+def test_bench_unknown_log_is_the_slam_error(tmp_path):
+    bench = run("bench", "--log", "atlantis", "--quiet")
+    slam = run("slam", "atlantis", "--trajectory", str(tmp_path / "t.txt"), "--quiet")
+    assert bench.returncode == slam.returncode == 2
+    assert bench.stderr == slam.stderr and bench.stderr.count("\n") == 1
+    assert "atlantis" in bench.stderr and "Traceback" not in bench.stderr
+
+
+def test_bench_log_options_need_log():
+    r = run("bench", "--method", "fht")
+    assert r.returncode == 2 and r.stderr == "fhslam: error: --method: only with --log\n"
+
+
 # ----------------------------------------------------------------------------- evaluate
 
 

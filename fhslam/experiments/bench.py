@@ -1,4 +1,5 @@
-"""``fhslam bench``: speed and accuracy of every line extractor on the same simulated scans.
+"""``fhslam bench``: speed and accuracy of every line extractor on the same simulated scans,
+and where a SLAM method's time goes on a real log.
 
 Time is the median over ``repeats`` calls per scan, then the median over scans, measured in
 one run with the extractors interleaved scan by scan (so machine load hits all alike). The
@@ -6,13 +7,20 @@ reference is the bare ``cv2.HoughLinesPointSet`` call with a 1 cm × 1° accumul
 same points — the classical Hough transform the paper claims to beat; the table gives each
 extractor's time as a ratio to it. Accuracy is scored with :mod:`fhslam.metrics` against the
 true walls. Scans come from held-out random worlds the extraction was not tuned on.
+
+:func:`run_log_bench` (``fhslam bench --log LOG``) runs a SLAM method over a log and splits its
+wall time into stages (extraction, tracking, loop closure, ...), measured by wrapping methods
+of the back-end *instance* with a :class:`StageTimer` (the SLAM modules are not changed); the
+per-scan times are again given as ratios to the same reference call, measured on the log's own
+scans before and after the run, so they compare across machines.
 """
 
 from __future__ import annotations
 
+import functools
 import time
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field, replace
 
 import cv2
 import numpy as np
@@ -27,6 +35,7 @@ from fhslam.baselines import (
     split_and_merge,
 )
 from fhslam.extraction import extract_lines
+from fhslam.io import Log
 from fhslam.lines import Line
 from fhslam.metrics import detection_scores
 from fhslam.scan import scan_to_points
@@ -166,4 +175,277 @@ def format_table(rows: Sequence[BenchRow]) -> str:
             f"{r.rms_dtheta_deg:9.2f}"
         )
         lines.append(f"{r.name:<28} {r.ms_per_scan:8.3f} {r.ratio_to_reference:9.2f} {acc}")
+    return "\n".join(lines)
+
+
+# ----------------------------------------------------------------------------- a real log
+
+
+class StageTimer:
+    """Wall seconds and calls per stage, accumulated by wrapping callables.
+
+    :meth:`wrap` returns a callable that times each call of ``fn`` into ``seconds[stage]``
+    and counts it in ``calls[stage]``; :meth:`patch` puts such a wrapper on one object's
+    attribute (an instance attribute: the class and its other instances are untouched).
+
+    Nested stages are subtracted: a stage's time is *exclusive*. While a wrapped call runs
+    inside another wrapped call (``_optimize`` inside ``_close_loops``), its time counts to
+    its own stage only and is taken off the enclosing one; so no second counts twice and the
+    stages of a run add up to at most its wall time.
+
+    Examples
+    --------
+    >>> timer = StageTimer()
+    >>> f = timer.wrap(sorted, "sorting")
+    >>> f([3, 1, 2]), timer.calls["sorting"]
+    ([1, 2, 3], 1)
+    """
+
+    def __init__(self, clock: Callable[[], float] = time.perf_counter) -> None:
+        self.clock = clock
+        """Seconds from an arbitrary origin (a fake clock makes a test exact)."""
+        self.seconds: dict[str, float] = {}
+        self.calls: dict[str, int] = {}
+        self._open: list[float] = []  # per open wrapped call: seconds of wrapped calls inside
+
+    def wrap(self, fn: Callable, stage: str) -> Callable:
+        """``fn``, timed into ``stage`` (see the class docs)."""
+        self.seconds.setdefault(stage, 0.0)
+        self.calls.setdefault(stage, 0)
+
+        @functools.wraps(fn)
+        def timed(*args, **kwargs):
+            self._open.append(0.0)
+            t0 = self.clock()
+            try:
+                return fn(*args, **kwargs)
+            finally:
+                dt = self.clock() - t0
+                inner = self._open.pop()
+                self.seconds[stage] += dt - inner
+                self.calls[stage] += 1
+                if self._open:
+                    self._open[-1] += dt
+
+        return timed
+
+    def patch(self, obj: object, name: str, stage: str) -> None:
+        """Replace ``obj.name`` (on ``obj`` itself) by its timed wrapper."""
+        setattr(obj, name, self.wrap(getattr(obj, name), stage))
+
+
+STAGES: dict[str, tuple[str, ...]] = {
+    "graph": ("extraction", "tracking", "local map", "loop closure", "optimisation", "map"),
+    "fht": ("extraction", "association", "map"),
+    "classical": ("extraction", "association", "map"),
+}
+"""The stages measured per SLAM method (every method also has ``"other"``: the rest of the wall
+time). ``graph`` (:class:`fhslam.slam.GraphFastHoughSLAM`): *extraction* the keyframes' Loop 1
+(the ``lines.extractor`` parameter), *tracking* scan-to-map matching (``tracker.track``),
+*local map* rebuilding the tracker's grids at each keyframe (``_update_local_map``), *loop
+closure* the search and verification of closures (``_close_loops`` less the optimisation it
+calls), *optimisation* the pose-graph solves (``_optimize``), *map* the map of reference lines
+at the end (``build_map``); *other* holds the keyframe clouds (densify, normals, voxel filter),
+pose arithmetic and the driver. ``fht`` and ``classical`` (:class:`fhslam.slam.FastHoughSLAM`):
+*extraction* Loop 1 (``extract``), *association* Loop 2 (``map.nearby`` and ``map.associate``),
+*map* merging into the reference lines (``map.update``); *other* is mostly the pose calibration
+(Loop 3). ``ekf`` and ``odometry``: the total only."""
+
+
+def instrumented_backend(method: str, timer: StageTimer):
+    """A fresh back end for ``method`` with its stages (:data:`STAGES`) timed by ``timer``."""
+    from fhslam.pipeline import make_backend
+    from fhslam.slam import GraphSlamParams
+
+    if method == "graph":
+        params = GraphSlamParams()
+        lines = params.lines
+        loop1 = lines.extractor or functools.partial(extract_lines, params=lines.extraction)
+        lines = replace(lines, extractor=timer.wrap(loop1, "extraction"))
+        backend = make_backend("graph", replace(params, lines=lines))
+        timer.patch(backend.tracker, "track", "tracking")
+        timer.patch(backend, "_update_local_map", "local map")
+        timer.patch(backend, "_close_loops", "loop closure")
+        timer.patch(backend, "_optimize", "optimisation")
+        timer.patch(backend, "build_map", "map")
+    elif method in ("fht", "classical"):
+        backend = make_backend(method)
+        timer.patch(backend, "extract", "extraction")
+        timer.patch(backend.map, "nearby", "association")
+        timer.patch(backend.map, "associate", "association")
+        timer.patch(backend.map, "update", "map")
+    else:
+        backend = make_backend(method)
+    return backend
+
+
+def log_head(log: Log, n: int) -> Log:
+    """The first ``n`` scans of ``log`` (all of them if it has fewer)."""
+    if n < 1:
+        raise ValueError(f"n must be >= 1, got {n}")
+
+    def cut(a):
+        return None if a is None else a[:n]
+
+    return replace(
+        log,
+        timestamps=log.timestamps[:n],
+        ranges=log.ranges[:n],
+        odometry=log.odometry[:n],
+        truth=cut(log.truth),
+        hits=cut(log.hits),
+        angle_offsets=cut(log.angle_offsets),
+    )
+
+
+def _reference_samples(log: Log, n: int = 25) -> list[NDArray[np.float64]]:
+    """The points of up to ``n`` scans spread over the log (dropped scans left out)."""
+    samples = []
+    for k in np.unique(np.linspace(0, len(log) - 1, n).astype(int)):
+        pts = log.scan(int(k)).points()[0]
+        if len(pts):
+            samples.append(pts)
+    return samples
+
+
+def _reference_seconds(samples: Sequence[NDArray[np.float64]], calls: int = 5) -> float:
+    """The reference call's time per scan: median over ``samples`` of the median of ``calls``."""
+    if not samples:
+        return float("nan")
+    return float(
+        np.median([_median_time(lambda p=p: cv2_pointset_call(p), calls) for p in samples])
+    )
+
+
+@dataclass(frozen=True)
+class LogBench:
+    """Where a SLAM method's time goes on one log (:func:`run_log_bench`).
+
+    Attributes
+    ----------
+    log, method : str
+    n_scans : int
+    duration : float
+        The log's time span from its timestamps, seconds.
+    seconds : float
+        Wall time of a run (``run_backend``: every step and ``finish``), seconds; the median
+        over the repeats.
+    stages : dict of str to float
+        Exclusive wall seconds per stage (:data:`STAGES`, then ``"other"``: the rest of the
+        run), each the median over the repeats (with one repeat they add up to ``seconds``).
+    calls : dict of str to int
+        Calls of each stage in one run.
+    reference_seconds : float
+        The reference call (:func:`cv2_pointset_call`) per scan on the log's scans: the mean
+        of its time before and after the run (median over repeats).
+    repeats : int
+    """
+
+    log: str
+    method: str
+    n_scans: int
+    duration: float
+    seconds: float
+    stages: dict[str, float] = field(repr=False)
+    calls: dict[str, int] = field(repr=False)
+    reference_seconds: float
+    repeats: int
+
+    @property
+    def steps_per_second(self) -> float:
+        """Scans per second of wall time."""
+        return self.n_scans / self.seconds
+
+    @property
+    def real_time_factor(self) -> float:
+        """The log's duration over the wall time (NaN for a log without a time span)."""
+        return self.duration / self.seconds if self.duration > 0 else float("nan")
+
+    def ms_per_scan(self, stage: str | None = None) -> float:
+        """A stage's (``None``: the whole run's) milliseconds per scan."""
+        s = self.seconds if stage is None else self.stages[stage]
+        return 1e3 * s / self.n_scans
+
+    def ratio_to_reference(self, stage: str | None = None) -> float:
+        """A stage's (``None``: the run's) time per scan over the reference call's."""
+        return (self.ms_per_scan(stage) / 1e3) / self.reference_seconds
+
+
+def run_log_bench(
+    log: Log, method: str = "graph", repeats: int = 1, progress: bool = True
+) -> LogBench:
+    """Run ``method`` over ``log`` ``repeats`` times and split the wall time into stages.
+
+    Each run gets a fresh back end (:func:`fhslam.pipeline.make_backend`) whose stage methods
+    are wrapped by a :class:`StageTimer` on the instance (:data:`STAGES`; nested stages are
+    subtracted, so the stages plus ``"other"`` add up to the run's wall time), driven by
+    :func:`fhslam.pipeline.run_backend`. The reference call is timed on a sample of the log's
+    scans right before and right after each run, so that machine load hits both alike. A
+    short untimed run over the first scans warms up JIT-compiled code and caches first.
+    Times are medians over the repeats; cProfile or another process slows both alike.
+    """
+    from fhslam.pipeline import make_backend, run_backend
+
+    if len(log) == 0:
+        raise ValueError("the log has no scans")
+    if repeats < 1:
+        raise ValueError(f"repeats must be >= 1, got {repeats}")
+    samples = _reference_samples(log)
+    run_backend(make_backend(method), log_head(log, 20))  # warm-up: JIT, caches
+    _reference_seconds(samples[:1], 1)
+    totals, refs, stage_runs = [], [], []
+    calls: dict[str, int] = {}
+    for r in range(repeats):
+        before = _reference_seconds(samples)
+        timer = StageTimer()
+        backend = instrumented_backend(method, timer)
+        desc = f"bench {method} {log.name}" + (f" ({r + 1}/{repeats})" if repeats > 1 else "")
+        t0 = time.perf_counter()
+        run_backend(backend, log, progress=progress, desc=desc)
+        total = time.perf_counter() - t0
+        after = _reference_seconds(samples)
+        stages = dict(timer.seconds)
+        stages["other"] = total - sum(stages.values())
+        totals.append(total)
+        refs.append((before + after) / 2)
+        stage_runs.append(stages)
+        calls = dict(timer.calls)
+    duration = float(log.timestamps[-1] - log.timestamps[0])
+    return LogBench(
+        log=log.name,
+        method=method,
+        n_scans=len(log),
+        duration=duration,
+        seconds=float(np.median(totals)),
+        stages={k: float(np.median([s[k] for s in stage_runs])) for k in stage_runs[0]},
+        calls=calls,
+        reference_seconds=float(np.median(refs)),
+        repeats=repeats,
+    )
+
+
+def format_log_bench(b: LogBench) -> str:
+    """The real-log bench as a header line and a plain-text table of stages."""
+    rt = "n/a" if np.isnan(b.real_time_factor) else f"{b.real_time_factor:.1f}"
+    med = f", medians of {b.repeats} runs" if b.repeats > 1 else ""
+    lines = [
+        f"{b.log} ({b.method}): {b.n_scans} scans ({b.duration:.1f} s of log), wall "
+        f"{b.seconds:.2f} s, {b.steps_per_second:.1f} scans/s, {rt} × real time{med}",
+        f"reference: {REFERENCE} on the log's scans, {1e3 * b.reference_seconds:.3f} ms/scan "
+        "(before and after the run)",
+    ]
+    head = f"{'stage':<14} {'ms/scan':>9} {'share':>7} {'time/ref':>9} {'calls':>7}"
+    lines += [head, "-" * len(head)]
+    if not b.calls:
+        lines.append(f"(no stages measured for {b.method}: the total only)")
+    for stage, s in b.stages.items() if b.calls else ():
+        calls = f"{b.calls[stage]:7d}" if stage in b.calls else ""
+        lines.append(
+            f"{stage:<14} {b.ms_per_scan(stage):9.3f} {100 * s / b.seconds:6.1f}% "
+            f"{b.ratio_to_reference(stage):9.2f} {calls}".rstrip()
+        )
+    lines.append("-" * len(head))
+    lines.append(
+        f"{'total':<14} {b.ms_per_scan():9.3f} {100.0:6.1f}% {b.ratio_to_reference():9.2f}"
+    )
     return "\n".join(lines)

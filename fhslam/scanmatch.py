@@ -123,8 +123,12 @@ class LikelihoodGrid:
         # processes on the same input): round the squares back to those integers, so the
         # grid depends on the points alone.
         d = cv2.distanceTransform(img, cv2.DIST_L2, cv2.DIST_MASK_PRECISE)
-        d2 = np.rint(np.square(d, dtype=np.float64))
-        values = np.exp(-0.5 * d2 * (resolution / sigma) ** 2).astype(np.float32)
+        # exp(-d²/2σ²) looked up by the integer d² (in cells²); the table runs to where
+        # float32 underflows to 0, so the values are exactly those of the formula
+        c2 = 0.5 * (resolution / sigma) ** 2
+        table = np.exp(-c2 * np.arange(int(np.ceil(104.0 / c2)) + 2)).astype(np.float32)
+        table[-1] = 0.0
+        values = _likelihood_lookup(d, table)
         return cls(values, lo, float(resolution))
 
     def score(self, points: ArrayLike, pose: ArrayLike) -> float:
@@ -134,6 +138,17 @@ class LikelihoodGrid:
         h, w = self.values.shape
         ok = (c[:, 0] >= 0) & (c[:, 0] < w) & (c[:, 1] >= 0) & (c[:, 1] < h)
         return float(self.values[c[ok, 1], c[ok, 0]].sum() / max(len(p), 1))
+
+
+@njit(cache=True)
+def _likelihood_lookup(d, table):  # pragma: no cover
+    out = np.empty(d.shape, np.float32)
+    last = table.shape[0] - 1
+    for i in range(d.shape[0]):
+        for j in range(d.shape[1]):
+            dd = np.float64(d[i, j])
+            out[i, j] = table[min(int(np.rint(dd * dd)), last)]
+    return out
 
 
 @njit(cache=True)
@@ -330,18 +345,26 @@ def densify(
 
 @dataclass(frozen=True)
 class PointMap:
-    """A target cloud ready for point-to-line matching: the points that have a normal, and a
-    k-d tree of them. Normals are given (e.g. :func:`scan_normals`; NaN: none) or come from
-    the principal axis of each point's ``k`` nearest neighbours. Points without a normal
-    (clutter, corners: the smaller spread over 1/4 of the larger) are left out, so every
-    query point's nearest neighbour has one."""
+    """A target cloud ready for point-to-line matching: the points that have a normal,
+    bucketed in square cells of ``cell`` metres for nearest-neighbour queries (each cell's
+    points are ``order[starts[c]:starts[c + 1]]``, cell ``c = ix · ny + iy`` from ``origin``).
+    Normals are given (e.g. :func:`scan_normals`; NaN: none) or come from the principal axis
+    of each point's ``k`` nearest neighbours. Points without a normal (clutter, corners: the
+    smaller spread over 1/4 of the larger) are left out, so every query point's nearest
+    neighbour has one."""
 
     points: NDArray[np.float64]
     normals: NDArray[np.float64]
-    tree: cKDTree
+    origin: NDArray[np.float64]
+    cell: float
+    shape: tuple[int, int]
+    starts: NDArray[np.int64]
+    order: NDArray[np.int64]
 
     @classmethod
-    def build(cls, points: ArrayLike, normals: ArrayLike | None = None, k: int = 6) -> PointMap:
+    def build(
+        cls, points: ArrayLike, normals: ArrayLike | None = None, k: int = 6, cell: float = 0.1
+    ) -> PointMap:
         """From points and, if known, their normals (:func:`scan_normals`, NaN: none)."""
         p = as_points(points, "target points")
         if normals is not None:
@@ -349,11 +372,10 @@ class PointMap:
             if len(nrm) != len(p):
                 raise ValueError(f"{len(nrm)} normals for {len(p)} points")
             ok = np.isfinite(nrm[:, 0])
-            return cls(p[ok], nrm[ok], cKDTree(p[ok]))
+            return cls._bucketed(p[ok], nrm[ok], cell)
         if len(p) < k:
             raise ValueError(f"a point map needs at least {k} points, got {len(p)}")
-        tree = cKDTree(p)
-        _, nb = tree.query(p, k=k)
+        _, nb = cKDTree(p).query(p, k=k)
         q = p[nb] - p[nb].mean(axis=1, keepdims=True)
         sxx, syy, sxy = (
             (q[..., 0] ** 2).sum(1),
@@ -365,7 +387,69 @@ class PointMap:
         # eigenvalues of the 2x2 scatter: spread across / along the local line
         half, mean = np.hypot(0.5 * (sxx - syy), sxy), 0.5 * (sxx + syy)
         ok = mean - half <= 0.25**2 * (mean + half)
-        return cls(p[ok], normals[ok], cKDTree(p[ok]))
+        return cls._bucketed(p[ok], normals[ok], cell)
+
+    @classmethod
+    def _bucketed(cls, p, normals, cell) -> PointMap:
+        if not cell > 0:
+            raise ValueError(f"cell must be > 0, got {cell}")
+        lo = p.min(axis=0) if len(p) else np.zeros(2)
+        extent = (p.max(axis=0) - lo) if len(p) else np.zeros(2)
+        cell = max(cell, float(np.sqrt(np.prod(extent + cell) / 4e6)))  # at most ~4e6 cells
+        ij = np.floor((p - lo) / cell).astype(np.int64)
+        nx, ny = (ij.max(axis=0) + 1) if len(p) else (1, 1)
+        c = ij[:, 0] * ny + ij[:, 1]
+        order = np.argsort(c, kind="stable")
+        starts = np.searchsorted(c[order], np.arange(nx * ny + 1)).astype(np.int64)
+        p = np.ascontiguousarray(p)
+        return cls(p, np.ascontiguousarray(normals), lo, float(cell), (int(nx), int(ny)),
+                   starts, order.astype(np.int64))  # fmt: skip
+
+
+@njit(cache=True)
+def _accumulate(
+    q0, x, y, th, pts, nrm, lo, cell, nx, ny, starts, order, max_d, huber
+):  # pragma: no cover
+    """One Gauss-Newton round of :func:`refine`: each query point at the pose ``(x, y, th)``
+    paired with its nearest map point closer than ``max_d``; returns the weighted normal
+    equations ``(H, g)``, the number of pairs and the sum of squared residuals."""
+    h = np.zeros((3, 3))
+    g = np.zeros(3)
+    c, s = np.cos(th), np.sin(th)
+    reach = int(np.ceil(max_d / cell))
+    n_ok, ss = 0, 0.0
+    jac = np.empty(3)
+    for k in range(q0.shape[0]):
+        qx = c * q0[k, 0] - s * q0[k, 1] + x
+        qy = s * q0[k, 0] + c * q0[k, 1] + y
+        ix = int(np.floor((qx - lo[0]) / cell))
+        iy = int(np.floor((qy - lo[1]) / cell))
+        best, bj = max_d * max_d, -1
+        for u in range(max(ix - reach, 0), min(ix + reach + 1, nx)):
+            for v in range(max(iy - reach, 0), min(iy + reach + 1, ny)):
+                cc = u * ny + v
+                for t in range(starts[cc], starts[cc + 1]):
+                    j = order[t]
+                    dx, dy = qx - pts[j, 0], qy - pts[j, 1]
+                    d2 = dx * dx + dy * dy
+                    if d2 < best or (d2 == best and bj >= 0 and j < bj):
+                        best, bj = d2, j
+        if bj < 0:
+            continue
+        nx_, ny_ = nrm[bj, 0], nrm[bj, 1]
+        r = nx_ * (qx - pts[bj, 0]) + ny_ * (qy - pts[bj, 1])
+        jac[0], jac[1] = nx_, ny_
+        jac[2] = ny_ * (qx - x) - nx_ * (qy - y)
+        # Huber on the residual, tapered to 0 at max_d: a pair forming or breaking at the
+        # cut-off changes nothing abruptly
+        w = min(1.0, huber / max(abs(r), 1e-12)) * (1.0 - best / (max_d * max_d)) ** 2
+        for a in range(3):
+            g[a] += w * jac[a] * r
+            for b in range(3):
+                h[a, b] += w * jac[a] * jac[b]
+        n_ok += 1
+        ss += r * r
+    return h, g, n_ok, ss
 
 
 @dataclass(frozen=True)
@@ -412,29 +496,22 @@ def refine(
         prior_info = np.asarray(prior[1], dtype=float).reshape(3, 3)
     h = np.zeros((3, 3))
     n_ok, rms = 0, 0.0
+    if not max_distance > 0:
+        raise ValueError(f"max_distance must be > 0, got {max_distance}")
+    if len(target.points) == 0:
+        return Refinement(x, h, 0, 0.0)
+    q0 = np.ascontiguousarray(q0)
+    nx, ny = target.shape
     for it in range(iterations):
-        q = transform_points(x, q0)
-        d, j = target.tree.query(q, distance_upper_bound=max_distance)
-        ok = d < max_distance
-        d, j, qk = d[ok], j[ok], q[ok]
-        n = target.normals[j]
-        n_ok = len(n)
+        h, g, n_ok, ss = _accumulate(
+            q0, x[0], x[1], x[2], target.points, target.normals, target.origin, target.cell,
+            nx, ny, target.starts, target.order, float(max_distance), float(huber),
+        )  # fmt: skip
         if n_ok < 10:
             return Refinement(x, np.zeros((3, 3)), n_ok, 0.0)
-        r = np.einsum("ij,ij->i", n, qk - target.points[j])
-        rel = qk - x[:2]
-        jac = np.column_stack([n, n[:, 1] * rel[:, 0] - n[:, 0] * rel[:, 1]])
-        # Huber on the residual, tapered to 0 at max_distance: a pair forming or breaking
-        # at the cut-off changes nothing abruptly
-        w = (
-            np.minimum(1.0, huber / np.maximum(np.abs(r), 1e-12))
-            * (1 - (d / max_distance) ** 2) ** 2
-        )
-        h = (jac * w[:, None]).T @ jac
-        rms = float(np.sqrt(np.mean(r * r)))
+        rms = float(np.sqrt(ss / n_ok))
         if it == iterations - 1:
             break
-        g = (jac * w[:, None]).T @ r
         if prior is not None:
             dp = x - prior_pose
             dp[2] = np.arctan2(np.sin(dp[2]), np.cos(dp[2]))

@@ -175,3 +175,41 @@ def test_point_map_and_refine_bad_input():
     pm = PointMap.build(_room())
     r = refine(pm, _room()[:5], [0.0, 0.0, 0.0])  # too few pairs: the guess, no information
     assert r.n_matched < 10 and np.array_equal(r.pose, np.zeros(3)) and not r.hessian.any()
+
+
+@pytest.mark.parametrize("max_distance", [0.05, 0.1, 0.15, 0.35])
+def test_refine_pairs_each_point_with_its_nearest_map_point(max_distance):
+    """The bucketed nearest-neighbour search pairs exactly as a k-d tree does: one round of
+    refine gives the normal equations of a brute-force pairing (to 1e-9 relative)."""
+    from scipy.spatial import cKDTree
+
+    from fhslam.geometry import transform_points
+    from fhslam.scanmatch import PointMap, refine
+
+    rng = np.random.default_rng(4)
+    target = rng.uniform(-6, 6, (3000, 2))
+    normals = rng.normal(size=(3000, 2))
+    normals /= np.hypot(*normals.T)[:, None]
+    query = rng.uniform(-7, 7, (400, 2))  # some off the map entirely
+    pose = np.array([0.05, -0.03, 0.02])
+    r = refine(PointMap.build(target, normals), query, pose, max_distance, iterations=1)
+    q = transform_points(pose, query)
+    d, j = cKDTree(target).query(q, distance_upper_bound=max_distance)
+    ok = d < max_distance
+    n, res = normals[j[ok]], np.einsum("ij,ij->i", normals[j[ok]], q[ok] - target[j[ok]])
+    rel = q[ok] - pose[:2]
+    jac = np.column_stack([n, n[:, 1] * rel[:, 0] - n[:, 0] * rel[:, 1]])
+    w = np.minimum(1, 0.02 / np.abs(res)) * (1 - (d[ok] / max_distance) ** 2) ** 2
+    assert r.n_matched == ok.sum() > 10
+    assert np.allclose(r.hessian, (jac * w[:, None]).T @ jac, rtol=1e-9, atol=0)
+    assert r.rms == pytest.approx(np.sqrt(np.mean(res**2)), rel=1e-12)
+
+
+def test_point_map_far_apart_points_stay_within_a_bounded_grid():
+    from fhslam.scanmatch import PointMap, refine
+
+    pts = np.array([[0.0, 0.0], [1e5, 1e5]] + [[x, 0.0] for x in np.arange(0.1, 2, 0.02)])
+    pm = PointMap.build(pts, np.tile([0.0, 1.0], (len(pts), 1)))
+    assert pm.shape[0] * pm.shape[1] <= 4.1e6  # cells grow instead of the grid
+    r = refine(pm, pts[2:40], [0.0, 0.01, 0.0], 0.1)
+    assert r.n_matched >= 10 and abs(r.pose[1]) < 1e-9

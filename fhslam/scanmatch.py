@@ -15,6 +15,7 @@ Used by :mod:`fhslam.slam.graph`; depends only on :mod:`fhslam.geometry`. The in
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass
 
 import cv2
@@ -105,6 +106,24 @@ class LikelihoodGrid:
     origin: NDArray[np.float64]
     resolution: float
 
+    @functools.cached_property
+    def pyramid(self) -> NDArray[np.float32]:
+        """Max-pooled copies of :attr:`values` for branch and bound, shape
+        ``(BNB_LEVELS + 1, rows + 2 p, cols + 2 p)`` with ``p = 2**BNB_LEVELS``: level ``L`` at
+        ``[L, p + r, p + c]`` holds the largest value of the ``2**L × 2**L`` cells from
+        ``(r, c)`` upwards (cells off the grid count 0). Computed once per grid."""
+        pad = 1 << BNB_LEVELS
+        h, w = self.values.shape
+        out = np.zeros((BNB_LEVELS + 1, h + 2 * pad, w + 2 * pad), np.float32)
+        out[0, pad : pad + h, pad : pad + w] = self.values
+        for level in range(1, BNB_LEVELS + 1):
+            s = 1 << (level - 1)
+            a, b = out[level - 1], out[level]
+            b[:, :] = a
+            np.maximum(b[:-s, :], a[s:, :], out=b[:-s, :])
+            np.maximum(b[:, :-s], b[:, s:].copy(), out=b[:, :-s])
+        return out
+
     @classmethod
     def build(
         cls, points: ArrayLike, resolution: float, sigma: float, margin: float
@@ -180,6 +199,125 @@ def _search(lik, ox, oy, res, px, py, x0, y0, th0, n_t, n_a, da, w_t, w_r):  # p
     return best_acc / max(n, 1), bx, by, bt
 
 
+BNB_LEVELS = 4
+"""Levels of the branch-and-bound search: the coarsest blocks are 16 × 16 shifts."""
+
+BNB_MIN_SHIFTS = 8
+"""Windows of fewer than this many shifts either side are searched exhaustively."""
+
+
+@njit(cache=True)
+def _bound(pyr, level, pad, ix, iy, sx, sy):  # pragma: no cover
+    """Sum over the points of the level's pooled value at their cell + (sx, sy)."""
+    h, w = pyr.shape[1], pyr.shape[2]
+    acc = 0.0
+    for k in range(ix.shape[0]):
+        u = ix[k] + sx + pad
+        v = iy[k] + sy + pad
+        if 0 <= u < w and 0 <= v < h:
+            acc += pyr[level, v, u]
+    return acc
+
+
+@njit(cache=True)
+def _search_bnb(pyr, ox, oy, res, px, py, x0, y0, th0, n_t, n_a, da, w_t, w_r):  # pragma: no cover
+    """:func:`_search` by branch and bound over the max-pooled grids ``pyr``
+    (:attr:`LikelihoodGrid.pyramid`): the same optimum, ties broken the same way (the first
+    of equal scores in the order angle, x shift, y shift)."""
+    n = px.shape[0]
+    pad = 1 << BNB_LEVELS
+    na = 2 * n_a + 1
+    ixs = np.empty((na, n), np.int64)
+    iys = np.empty((na, n), np.int64)
+    for a in range(na):
+        th = th0 + (a - n_a) * da
+        c, s = np.cos(th), np.sin(th)
+        for k in range(n):
+            ixs[a, k] = int(np.floor((c * px[k] - s * py[k] + x0 - ox) / res))
+            iys[a, k] = int(np.floor((s * px[k] + c * py[k] + y0 - oy) / res))
+    nn = max(n, 1)
+    top = BNB_LEVELS
+    # stack of (level, angle, sx, sy) with their bounds
+    cap = 64 + na * ((2 * n_t) // (1 << top) + 2) ** 2 + 4 * top * 64
+    st_l = np.empty(cap, np.int64)
+    st_a = np.empty(cap, np.int64)
+    st_x = np.empty(cap, np.int64)
+    st_y = np.empty(cap, np.int64)
+    st_b = np.empty(cap, np.float64)
+    sp = 0
+    # the coarsest blocks, pushed in increasing order of their bound (best popped first)
+    nb = ((2 * n_t) >> top) + 1
+    m = na * nb * nb
+    cb = np.empty(m)
+    ca = np.empty(m, np.int64)
+    cx = np.empty(m, np.int64)
+    cy = np.empty(m, np.int64)
+    i = 0
+    for a in range(na):
+        for bx in range(nb):
+            for by in range(nb):
+                sx, sy = -n_t + (bx << top), -n_t + (by << top)
+                ca[i], cx[i], cy[i] = a, sx, sy
+                cb[i] = _block_score(
+                    pyr, top, pad, ixs[a], iys[a], sx, sy, n_t, a - n_a, nn, res, da, w_t, w_r
+                )
+                i += 1
+    order = np.argsort(cb)
+    for t in range(m):
+        q = order[t]
+        st_l[sp], st_a[sp], st_x[sp], st_y[sp], st_b[sp] = top, ca[q], cx[q], cy[q], cb[q]
+        sp += 1
+    best, best_acc = -np.inf, 0.0
+    ba, bx_, by_ = 0, 0, 0
+    cb4 = np.empty(4)
+    cx4 = np.empty(4, np.int64)
+    cy4 = np.empty(4, np.int64)
+    while sp > 0:
+        sp -= 1
+        lv, a, sx, sy, bnd = st_l[sp], st_a[sp], st_x[sp], st_y[sp], st_b[sp]
+        if bnd < best:
+            continue
+        if lv == 0:
+            acc = _bound(pyr, 0, pad, ixs[a], iys[a], sx, sy)
+            sc = acc / nn - w_t * res * np.sqrt(sx * sx + sy * sy) - w_r * abs((a - n_a) * da)
+            if sc > best or (sc == best and (a, sx, sy) < (ba, bx_, by_)):
+                best, best_acc, ba, bx_, by_ = sc, acc, a, sx, sy
+            continue
+        half = 1 << (lv - 1)
+        nc = 0
+        for dx in range(2):
+            for dy in range(2):
+                x, y = sx + dx * half, sy + dy * half
+                if x > n_t or y > n_t:
+                    continue
+                cx4[nc], cy4[nc] = x, y
+                cb4[nc] = _block_score(
+                    pyr, lv - 1, pad, ixs[a], iys[a], x, y, n_t, a - n_a, nn, res, da, w_t, w_r
+                )
+                nc += 1
+        o = np.argsort(cb4[:nc])
+        for t in range(nc):
+            q = o[t]
+            if cb4[q] >= best:
+                st_l[sp], st_a[sp], st_x[sp], st_y[sp], st_b[sp] = lv - 1, a, cx4[q], cy4[q], cb4[q]
+                sp += 1
+    return best_acc / nn, x0 + bx_ * res, y0 + by_ * res, th0 + (ba - n_a) * da
+
+
+@njit(cache=True)
+def _block_score(
+    pyr, level, pad, ix, iy, sx, sy, n_t, ka, nn, res, da, w_t, w_r
+):  # pragma: no cover
+    """An upper bound of the score of every shift in the block of ``2**level`` shifts from
+    ``(sx, sy)`` (clipped at ``n_t``): pooled likelihoods minus the smallest prior."""
+    size = (1 << level) - 1
+    hx, hy = min(sx + size, n_t), min(sy + size, n_t)
+    mx = 0 if sx <= 0 <= hx else min(abs(sx), abs(hx))
+    my = 0 if sy <= 0 <= hy else min(abs(sy), abs(hy))
+    acc = _bound(pyr, level, pad, ix, iy, sx, sy)
+    return acc / nn - w_t * res * np.sqrt(mx * mx + my * my) - w_r * abs(ka * da)
+
+
 def correlative_search(
     grid: LikelihoodGrid,
     points: NDArray[np.float64],
@@ -196,8 +334,9 @@ def correlative_search(
     radian of distance from the guess; the score returned is the plain one."""
     n_t = round(window / grid.resolution)
     n_a = int(np.ceil(window_angle / angle_step - 1e-9))
-    s, x, y, t = _search(
-        grid.values, float(grid.origin[0]), float(grid.origin[1]), grid.resolution,
+    kernel, table = (_search_bnb, grid.pyramid) if n_t >= BNB_MIN_SHIFTS else (_search, grid.values)
+    s, x, y, t = kernel(
+        table, float(grid.origin[0]), float(grid.origin[1]), grid.resolution,
         np.ascontiguousarray(points[:, 0]), np.ascontiguousarray(points[:, 1]),
         float(guess[0]), float(guess[1]), float(guess[2]), n_t, n_a, float(angle_step),
         float(prior[0]), float(prior[1]),
@@ -363,7 +502,7 @@ class PointMap:
 
     @classmethod
     def build(
-        cls, points: ArrayLike, normals: ArrayLike | None = None, k: int = 6, cell: float = 0.1
+        cls, points: ArrayLike, normals: ArrayLike | None = None, k: int = 6, cell: float = 0.15
     ) -> PointMap:
         """From points and, if known, their normals (:func:`scan_normals`, NaN: none)."""
         p = as_points(points, "target points")
@@ -425,15 +564,39 @@ def _accumulate(
         ix = int(np.floor((qx - lo[0]) / cell))
         iy = int(np.floor((qy - lo[1]) / cell))
         best, bj = max_d * max_d, -1
-        for u in range(max(ix - reach, 0), min(ix + reach + 1, nx)):
-            for v in range(max(iy - reach, 0), min(iy + reach + 1, ny)):
-                cc = u * ny + v
-                for t in range(starts[cc], starts[cc + 1]):
-                    j = order[t]
-                    dx, dy = qx - pts[j, 0], qy - pts[j, 1]
-                    d2 = dx * dx + dy * dy
-                    if d2 < best or (d2 == best and bj >= 0 and j < bj):
-                        best, bj = d2, j
+        # cells in rings around the point's own; a cell (or a ring) whose nearest edge is
+        # farther than the best pair so far cannot hold a nearer point (the margin covers
+        # rounding in the cell index)
+        ax, ay = qx - lo[0] - ix * cell, qy - lo[1] - iy * cell
+        for r in range(reach + 1):
+            if r >= 2 and ((r - 1) * cell) ** 2 > best * (1 + 1e-9) + 1e-18:
+                break
+            for u in range(ix - r, ix + r + 1):
+                if u < 0 or u >= nx:
+                    continue
+                gx = (
+                    0.0
+                    if u == ix
+                    else ((u - ix) * cell - ax if u > ix else ax + (ix - u - 1) * cell)
+                )
+                step = 1 if abs(u - ix) == r else 2 * r
+                for v in range(iy - r, iy + r + 1, max(step, 1)):
+                    if v < 0 or v >= ny:
+                        continue
+                    gy = (
+                        0.0
+                        if v == iy
+                        else ((v - iy) * cell - ay if v > iy else ay + (iy - v - 1) * cell)
+                    )
+                    if gx * gx + gy * gy > best * (1 + 1e-9) + 1e-18:
+                        continue
+                    cc = u * ny + v
+                    for t in range(starts[cc], starts[cc + 1]):
+                        j = order[t]
+                        dx, dy = qx - pts[j, 0], qy - pts[j, 1]
+                        d2 = dx * dx + dy * dy
+                        if d2 < best or (d2 == best and bj >= 0 and j < bj):
+                            best, bj = d2, j
         if bj < 0:
             continue
         nx_, ny_ = nrm[bj, 0], nrm[bj, 1]
@@ -494,14 +657,13 @@ def refine(
     if prior is not None:
         prior_pose = as_pose(prior[0], "prior pose")
         prior_info = np.asarray(prior[1], dtype=float).reshape(3, 3)
-    h = np.zeros((3, 3))
-    n_ok, rms = 0, 0.0
     if not max_distance > 0:
         raise ValueError(f"max_distance must be > 0, got {max_distance}")
-    if len(target.points) == 0:
-        return Refinement(x, h, 0, 0.0)
+    if len(target.points) == 0 or iterations < 1:
+        return Refinement(x, np.zeros((3, 3)), 0, 0.0)
     q0 = np.ascontiguousarray(q0)
     nx, ny = target.shape
+    h, n_ok, rms = np.zeros((3, 3)), 0, 0.0
     for it in range(iterations):
         h, g, n_ok, ss = _accumulate(
             q0, x[0], x[1], x[2], target.points, target.normals, target.origin, target.cell,

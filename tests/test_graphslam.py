@@ -49,6 +49,21 @@ def test_closures_that_agree_are_added_without_optimising(three_laps):
     assert ate(lazy, truth).rmse <= ate(eager, truth).rmse + 0.002  # measured 1.496 vs 1.497 cm
 
 
+def test_a_closure_that_moves_its_keyframe_far_waits_for_an_independent_one():
+    """Held closures agree when, carried along the graph to the same keyframe, they place
+    it within 15 cm and 2° (``loop_consistency``, ``loop_consistency_deg``)."""
+    from fhslam.geometry import compose
+
+    slam = GraphFastHoughSLAM()
+    poses = np.array([[0.0, 0.0, 0.0]] * 10 + [[5.0, 0.0, 0.0], [5.5, 0.0, 0.1]])
+    moved = np.array([0.8, 0.1, 0.02])  # where the first held closure puts keyframe 10
+    g = (0, 10, None, None, 0.6, compose(poses[10], moved))
+    same = compose(compose(poses[10], moved), [0.5, 0.05, 0.1])  # keyframe 11 alike
+    assert slam._agree(g, (1, 11, None, None, 0.6, same), poses)
+    for off in ([0.16, 0.0, 0.0], [0.0, 0.0, np.radians(2.5)]):
+        assert not slam._agree(g, (1, 11, None, None, 0.6, compose(same, off)), poses)
+
+
 def test_same_log_same_numbers(three_laps):
     a = run_slam(three_laps, "graph").poses
     b = run_slam(three_laps, "graph").poses
@@ -77,6 +92,8 @@ def test_without_loop_closures_no_loop_edges(three_laps):
         ("loop_min_score", 1.5, r"loop_min_score must be in \[0, 1\]"),
         ("submap_keyframes", 0, "submap_keyframes and loop_min_gap must be >= 1"),
         ("loop_optimize_chi2", -1.0, "loop_optimize_chi2 must be >= 0"),
+        ("loop_consistency", 0.0, "loop_consistency must be > 0"),
+        ("loop_confirm_window", 0, "loop_confirm_window must be >= 1"),
     ],
 )
 def test_bad_parameters_are_named(field, value, message):
@@ -94,12 +111,18 @@ CLINIC = (
 )
 
 
-def _relations_error(real_data, name):
+def _relations_error(real_data, name, odometry_noise_seed=None):
+    from dataclasses import replace
+
     from fhslam.datasets import find_dataset, load_log
     from fhslam.io import read_relations
     from fhslam.metrics import relations_error
 
     log = load_log(name)  # found where the real_data fixture found them
+    if odometry_noise_seed is not None:  # last-bit noise: what another CPU may do
+        rng = np.random.default_rng(odometry_noise_seed)
+        odometry = log.odometry * (1 + 1e-15 * rng.standard_normal(log.odometry.shape))
+        log = replace(log, odometry=odometry)
     r = run_slam(log)  # the default method, the same defaults for every log
     rel = read_relations(find_dataset(name, "relations"))
     return relations_error(r.timestamps, r.poses, *rel)
@@ -111,9 +134,9 @@ def _relations_error(real_data, name):
 # differences between CPUs. README: the table and the commands.
 REAL_LOGS = {
     "intel": (0.05, 0.0139),
-    "aces": (0.06, 0.0474),
-    "mit-csail": (0.06, 0.0427),
-    "fr079": (0.08, 0.0655),
+    "aces": (0.06, 0.0452),
+    "mit-csail": (0.06, 0.0267),
+    "fr079": (0.08, 0.0652),
     "fr-clinic": (0.15, 2.08),
 }
 
@@ -132,3 +155,12 @@ def test_real_log_relations_error_meets_issue_10(real_data, name):
     e = _relations_error(real_data, name)
     assert e.n_used == e.n_total
     assert e.trans_mean <= limit, f"{name}: {e.trans_mean:.4f} m (measured {measured} m)"
+
+
+@pytest.mark.parametrize("seed", [1, 2])
+def test_mit_csail_does_not_turn_on_the_last_bit(real_data, seed):
+    """The odometry multiplied by (1 + 1e-15 ε): before closures that move a keyframe far
+    waited for an independent one, seed 2 gave 0.394 m instead of 0.043 m; measured now
+    0.0266-0.0271 m for seeds 0-3 and unperturbed."""
+    e = _relations_error(real_data, "mit-csail", odometry_noise_seed=seed)
+    assert e.trans_mean <= 0.035, f"seed {seed}: {e.trans_mean:.4f} m"

@@ -134,6 +134,22 @@ class GraphSlamParams:
         Intel 80 % of the closures agree to within one standard deviation, and 1.0 takes the
         solves from 615 to 235; the default 0 (optimise after every closure) stays until
         MIT CSAIL's result no longer depends on millimetres (README, issue 10).
+    loop_confirm_distance : float
+        A closure that would move its keyframe by more than this (metres)...
+    loop_confirm_deg : float
+        ... or turn it by more than this (degrees) is held until a closure from a query
+        that shares no keyframe with it, within ``loop_confirm_window`` keyframes, agrees:
+        carried along the graph to the same keyframe, the two place it within
+        ``loop_consistency`` metres and ``loop_consistency_deg`` degrees. A corridor lined
+        with doors matches as well one door further, and so does the next keyframe's query,
+        which shares two thirds of its points; two queries apart rarely agree on the
+        wrong door (MIT CSAIL: the relation error no longer turns on the last bit).
+    loop_consistency : float
+        See ``loop_confirm_deg``.
+    loop_consistency_deg : float
+        See ``loop_confirm_deg``.
+    loop_confirm_window : int
+        See ``loop_confirm_deg``.
     optimize_iterations : int
         Largest number of Gauss-Newton rounds after a keyframe that closed a loop...
     optimize_tol : float
@@ -165,6 +181,11 @@ class GraphSlamParams:
     loop_kernel: float = 1.0
     loop_max_chi2: float = 25.0
     loop_optimize_chi2: float = 0.0
+    loop_confirm_distance: float = 0.3
+    loop_confirm_deg: float = 3.0
+    loop_consistency: float = 0.15
+    loop_consistency_deg: float = 2.0
+    loop_confirm_window: int = 10
     optimize_iterations: int = 10
     optimize_tol: float = 1e-4
 
@@ -176,6 +197,10 @@ class GraphSlamParams:
             "cloud_voxel",
             "edge_sigma",
             "edge_points",
+            "loop_confirm_distance",
+            "loop_confirm_deg",
+            "loop_consistency",
+            "loop_consistency_deg",
         ):
             if not getattr(self, name) > 0:
                 raise ValueError(f"{name} must be > 0, got {getattr(self, name)}")
@@ -183,6 +208,8 @@ class GraphSlamParams:
             raise ValueError(
                 "submap_keyframes and loop_min_gap must be >= 1 and loop_candidates >= 0"
             )
+        if self.loop_confirm_window < 1:
+            raise ValueError(f"loop_confirm_window must be >= 1, got {self.loop_confirm_window}")
         if not self.loop_optimize_chi2 >= 0:
             raise ValueError(f"loop_optimize_chi2 must be >= 0, got {self.loop_optimize_chi2}")
         if not 0 <= self.loop_min_score <= 1:
@@ -240,6 +267,7 @@ class GraphFastHoughSLAM:
         self._path: list[float] = []  # distance travelled at each keyframe
         self._last_loop_path = 0.0
         self._doubtful = 0  # doubtful scans in a row
+        self._pending: list[tuple[int, int, NDArray, NDArray, float, NDArray]] = []
         self._kf_doubt = False  # whether a scan since the last keyframe was doubtful
         self._scan_kf: list[int] = []
         self._scan_rel: list[NDArray[np.float64]] = []
@@ -398,7 +426,7 @@ class GraphFastHoughSLAM:
         win = p.tracker.window if tracking else min(p.loop_max_window, p.loop_window + drift)
         win_deg = p.tracker.window_deg + 2 if tracking else p.loop_window_deg
         q_refine = voxel_downsample(query, 0.05)
-        closed = []
+        closed, held = [], []
         for j in cands[:1] if tracking else cands:
             target, normals = self._submap(
                 j, range(max(0, j - 3), min(j + 4, i - p.loop_min_gap + 1))
@@ -412,15 +440,48 @@ class GraphFastHoughSLAM:
             if ref.n_matched < p.loop_min_pairs or ref.rms > p.loop_max_rms:
                 continue
             z = ref.pose if np.hypot(*(ref.pose[:2] - m.pose[:2])) <= 0.05 else m.pose
-            e = self.graph.add_edge(
-                j, i, z, self._information(ref, float(z[2])), p.loop_kernel, kind="loop"
-            )
-            self.loops.append(LoopClosure(j, i, z, m.score, e))
-            closed.append(e)
+            info = self._information(ref, float(z[2]))
+            implied = compose(poses[j], z)  # where the closure puts keyframe i
+            move = implied - poses[i]
+            if not tracking and (
+                np.hypot(move[0], move[1]) > p.loop_confirm_distance
+                or abs(np.degrees(np.angle(np.exp(1j * move[2])))) > p.loop_confirm_deg
+            ):
+                held.append((j, i, z, info, m.score, implied))
+                continue
+            closed.append(self._add_loop(j, i, z, info, m.score))
+        if closed:
+            self._pending = []  # the estimate is confirmed as it stands
+        self._pending = [h for h in self._pending if i - h[1] <= p.loop_confirm_window]
+        for h in held:
+            # from a query that shares no keyframe with this one (queries span 3 keyframes)
+            support = [g for g in self._pending if g[1] <= i - 3 and self._agree(g, h, poses)]
+            if support:
+                for g in [*support, h]:
+                    closed.append(self._add_loop(g[0], g[1], g[2], g[3], g[4]))
+                self._pending = [g for g in self._pending if not any(g is x for x in support)]
+            else:
+                self._pending.append(h)
         if closed:
             self._last_loop_path = self._path[i]
             if self.graph.chi2(np.array(closed)).max() >= p.loop_optimize_chi2:
                 self._optimize()
+
+    def _add_loop(self, j: int, i: int, z, info, score: float) -> int:
+        e = self.graph.add_edge(j, i, z, info, self.params.loop_kernel, kind="loop")
+        self.loops.append(LoopClosure(j, i, z, score, e))
+        return e
+
+    def _agree(self, g, h, poses) -> bool:
+        """Whether held closures ``g`` and ``h`` place keyframe ``h``'s ``i`` alike (``g``'s
+        placement carried along the graph)."""
+        p = self.params
+        carried = compose(g[5], relative(poses[g[1]], poses[h[1]]))
+        d = carried - h[5]
+        return bool(
+            np.hypot(d[0], d[1]) <= p.loop_consistency
+            and abs(np.degrees(np.angle(np.exp(1j * d[2])))) <= p.loop_consistency_deg
+        )
 
     def _optimize(self) -> None:
         """Optimise; switch off loop edges that stay inconsistent, optimise again."""

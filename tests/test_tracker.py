@@ -52,3 +52,53 @@ def test_tracker_parameters_are_checked():
         TrackerParams(prior_sigma=(0.05, 0.0))
     with pytest.raises(ValueError, match="residual_sigma must be > 0"):
         TrackerParams(residual_sigma=-1.0)
+
+
+def _room_points(step=0.02):
+    """The walls of a 6 x 4 m room with a 1 m box in it (world frame)."""
+    t = np.arange(0, 1, step / 6)
+    walls = [((0, 0), (6, 0)), ((6, 0), (6, 4)), ((6, 4), (0, 4)), ((0, 4), (0, 0))]
+    walls += [((3, 1.5), (4, 1.5)), ((4, 1.5), (4, 2.5)), ((4, 2.5), (3, 2.5))]
+    return np.vstack([np.outer(1 - t, a) + np.outer(t, b) for a, b in walls])
+
+
+@pytest.mark.parametrize(
+    ("odometry_step", "true_step", "centre"),
+    [(0.3, 0.6, "predicted"), (0.6, 0.1, "previous")],
+    ids=["plausible-odometry", "odometry-jump"],
+)
+def test_after_a_doubtful_scan_the_wide_search_starts_where_the_odometry_is_plausible(
+    monkeypatch, odometry_step, true_step, centre
+):
+    """After a doubtful scan the tracker searches widely again. With an odometry increment
+    a robot can make between two scans that search is centred on the prediction, keeping
+    the odometry prior (on the Freiburg hospital log, centring it on the previous pose let
+    poor scans jump 0.5-0.7 m and 10-25 degrees); only an implausible increment (a glitch)
+    centres it on the previous pose, as if the robot stood still, and drops the prior."""
+    import fhslam.slam.tracker as tracker_module
+    from fhslam.geometry import transform_points
+    from fhslam.scanmatch import scan_normals
+    from fhslam.slam.tracker import ScanTracker
+
+    world = _room_points()
+    tr = ScanTracker()
+    tr.set_map(world, scan_normals(world))
+    previous = np.array([1.5, 2.0, 0.1])  # the doubtful previous estimate
+    predicted = compose(previous, [odometry_step, 0.0, 0.0])
+    truth = compose(previous, [true_step, 0.0, 0.0])  # 0.3 / 0.5 m from the prediction
+    scan = transform_points(inverse(truth), world)
+    scan = scan[np.hypot(scan[:, 0], scan[:, 1]) < 8]
+    centres = []
+    search = tracker_module.correlative_search
+
+    def spy(grid, q, pose, *args):
+        centres.append(np.array(pose))
+        return search(grid, q, pose, *args)
+
+    monkeypatch.setattr(tracker_module, "correlative_search", spy)
+    tr._doubt = True  # the previous scan was placed with a middling score
+    t = tr.track(scan, predicted, previous)
+    assert len(centres) == 2  # the search at the prediction, then the wide one
+    np.testing.assert_allclose(centres[1], predicted if centre == "predicted" else previous)
+    assert np.hypot(*(t.pose[:2] - truth[:2])) < 0.01  # the wide search found it: < 1 cm
+    assert t.recovered == (centre == "previous")  # only a glitch drops the odometry prior

@@ -191,18 +191,19 @@ class ScanTracker:
         )
         recovered = False
         doubt, self._doubt = self._doubt, True
-        if doubt or score < p.sure_score or np.hypot(*step) > p.max_step or turn > p.max_turn_deg:
+        glitch = np.hypot(*step) > p.max_step or turn > p.max_turn_deg
+        if doubt or score < p.sure_score or glitch:
             s2, pose2 = correlative_search(
                 self._grid,
                 q,
-                as_pose(previous, "previous"),
+                as_pose(previous, "previous") if glitch else predicted,
                 p.recovery_window,
                 np.radians(p.recovery_window_deg),
                 da,
-                (0.05, 0.05),
+                (0.05, 0.05) if glitch else p.search_prior,
             )
             if s2 > score + 0.02:
-                score, pose, recovered = s2, pose2, True
+                score, pose, recovered = s2, pose2, glitch
         if score < p.min_score:
             return Track(predicted, score, False, False, False, None)
         s_xy, s_deg = p.prior_sigma

@@ -102,3 +102,35 @@ def test_after_a_doubtful_scan_the_wide_search_starts_where_the_odometry_is_plau
     np.testing.assert_allclose(centres[1], predicted if centre == "predicted" else previous)
     assert np.hypot(*(t.pose[:2] - truth[:2])) < 0.01  # the wide search found it: < 1 cm
     assert t.recovered == (centre == "previous")  # only a glitch drops the odometry prior
+
+
+def test_turning_into_unseen_space_the_previous_scan_places_the_scan():
+    """A fast turn into space the local map has not seen: the map holds what the robot saw
+    looking at 140 degrees, the previous scan (at 100 degrees) was placed by a match, the
+    scan now (at 60 degrees) scores below ``min_score`` against the map and the odometry
+    under-reports the turn by 12 degrees. Matched against the previous scan, which saw most
+    of that space, it is placed surely (on MIT CSAIL with 10 % of the scans dropped this took
+    the relation error from 0.73 m to 0.028 m)."""
+    from fhslam.geometry import transform_points
+    from fhslam.scanmatch import scan_normals
+    from fhslam.slam.tracker import ScanTracker
+
+    world = _room_points()
+
+    def scan_at(pose):
+        s = transform_points(inverse(pose), world)
+        ahead = (s[:, 0] > 0) & (np.hypot(s[:, 0], s[:, 1]) < 8)  # a 180 degree laser
+        return s[ahead]
+
+    old = np.array([2.5, 2.0, np.radians(140)])
+    c, s = np.cos(old[2]), np.sin(old[2])
+    tr = ScanTracker()
+    tr.set_map(transform_points(old, scan_at(old)), scan_normals(scan_at(old)) @ [[c, s], [-s, c]])
+    previous = np.array([2.5, 2.0, np.radians(100)])
+    assert tr.track(scan_at(previous), previous, previous).matched  # measured score 0.60
+    truth = np.array([2.55, 2.05, np.radians(60)])
+    predicted = compose(previous, [0.07, 0.0, np.radians(-40 + 12)])
+    t = tr.track(scan_at(truth), predicted, previous)
+    assert t.sure and t.matched  # measured score 0.71 (0.35 against the map alone)
+    assert np.hypot(*(t.pose[:2] - truth[:2])) < 0.01  # measured: < 1 mm
+    assert abs(np.degrees(t.pose[2] - truth[2])) < 0.2

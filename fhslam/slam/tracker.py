@@ -11,9 +11,18 @@ position jump of most of a metre. When the match at the prediction scores below
 ``min_score``, or the odometry increment is larger than a robot moves between two scans,
 a second search around the previous pose (the robot stood still) with a wide window
 competes with it; the better score wins. When neither matches, the odometry prediction is
-kept: the fallback. A scan placed with a middling score (under ``sure_score``) is not
-trusted further: the next scan searches widely again, and the graph neither starts a
-keyframe on it nor adds its points to the map.
+kept: the fallback. After a doubtful scan the next one searches widely again, centred on
+the prediction when the odometry increment is plausible (on the previous pose only after a
+glitch).
+
+Turning fast into space the local map has not seen (a 5 Hz laser turning 50° between two
+scans), a scan scores low against the map although nothing is wrong. When the map gives no
+sure match, the scan is also searched against the previous scan (densified, at its tracked
+pose), which has seen most of that space; a sure match there places it. Only a previous scan
+placed by a match counts: one left at the odometry's guess (after a glitch on ACES, 70° off)
+would pass its error on. A scan placed
+with a middling score (under ``sure_score``) by both is not trusted further: the graph
+neither starts a keyframe on it nor adds its points to the map.
 
 The local map's grids are built once per keyframe (:meth:`ScanTracker.set_map`), not per
 scan.
@@ -26,13 +35,15 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from fhslam.geometry import as_pose
+from fhslam.geometry import as_pose, transform_points
 from fhslam.scanmatch import (
     LikelihoodGrid,
     PointMap,
     Refinement,
     correlative_search,
+    densify,
     refine,
+    scan_normals,
     voxel_downsample,
 )
 
@@ -150,6 +161,7 @@ class ScanTracker:
         self._grid: LikelihoodGrid | None = None
         self._points: PointMap | None = None
         self._doubt = False  # the last scan was not placed surely
+        self._last: NDArray[np.float64] | None = None  # the last matched scan's points
 
     def set_map(self, points: NDArray[np.float64], normals: NDArray[np.float64]) -> None:
         """Use ``points`` (in the tracking frame) with their ``normals`` (NaN: none; see
@@ -173,6 +185,7 @@ class ScanTracker:
         moved by the odometry increment); ``previous`` is the previous scan's pose."""
         p = self.params
         predicted = as_pose(predicted, "predicted")
+        last, self._last = self._last, None
         q = _thin(voxel_downsample(points, p.query_voxel), p.max_points)
         if self._grid is None or len(q) < 10:
             self._doubt = True
@@ -204,14 +217,40 @@ class ScanTracker:
             )
             if s2 > score + 0.02:
                 score, pose, recovered = s2, pose2, glitch
+        target = self._points
+        if score < p.sure_score and last is not None and len(last) >= 10:
+            # Turning fast into space the map has not seen: the previous scan has seen it.
+            centre = as_pose(previous, "previous")
+            cloud, normals = densify(last, scan_normals(last))
+            c, s = np.cos(centre[2]), np.sin(centre[2])
+            cloud, normals = transform_points(centre, cloud), normals @ [[c, s], [-s, c]]
+            grid = LikelihoodGrid.build(
+                voxel_downsample(cloud, p.resolution / 2),
+                p.resolution,
+                p.sigma,
+                p.recovery_window + 3 * p.sigma,
+            )
+            s3, pose3 = correlative_search(
+                grid,
+                q,
+                centre if glitch else predicted,
+                p.recovery_window,
+                np.radians(p.recovery_window_deg),
+                da,
+                (0.05, 0.05) if glitch else p.search_prior,
+            )
+            if s3 >= p.sure_score and s3 > score:
+                score, pose, recovered = s3, pose3, glitch
+                target = PointMap.build(cloud, normals)
         if score < p.min_score:
             return Track(predicted, score, False, False, False, None)
         s_xy, s_deg = p.prior_sigma
         info = p.residual_sigma**2 * np.diag([1 / s_xy**2, 1 / s_xy**2, 1 / np.radians(s_deg) ** 2])
         # after a glitch (recovered) the prediction is wrong: no prior then
         prior = None if recovered else (predicted, info)
-        ref = refine(self._points, points, pose, p.refine_distance, prior=prior)
+        ref = refine(target, points, pose, p.refine_distance, prior=prior)
         if ref.n_matched >= 10 and np.hypot(*(ref.pose[:2] - pose[:2])) <= p.window:
             pose = ref.pose
         self._doubt = score < p.sure_score
+        self._last = points  # placed by a match: the next scan may chain on it
         return Track(pose, score, True, recovered, not self._doubt, ref)

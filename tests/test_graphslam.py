@@ -139,9 +139,9 @@ def _relations_error(real_data, name, odometry_noise_seed=None, drop_fraction=0.
 # differences between CPUs. README: the table and the commands.
 REAL_LOGS = {
     "intel": (0.05, 0.0135),
-    "aces": (0.06, 0.0465),
-    "mit-csail": (0.06, 0.0269),
-    "fr079": (0.08, 0.0629),
+    "aces": (0.06, 0.0346),
+    "mit-csail": (0.06, 0.0270),
+    "fr079": (0.08, 0.0643),
     "fr-clinic": (0.15, 2.47),
 }
 
@@ -180,3 +180,13 @@ def test_mit_csail_survives_dropped_scans(real_data):
     e = _relations_error(real_data, "mit-csail", drop_fraction=0.1)
     assert e.n_used < e.n_total  # relations at dropped scans cannot be evaluated
     assert e.trans_mean <= 0.0369, f"{e.trans_mean:.4f} m"  # 0.0269 m + 1 cm
+
+
+@pytest.mark.parametrize("seed", [None, 1])
+def test_aces_revisit_is_closed_whatever_the_last_bit(real_data, seed):
+    """ACES's revisit (scans 158-172 against 4194-4422): with a Cauchy scale of 1 the
+    closures there lost most of their pull and the two visits stayed 1.1-1.3 m apart unless
+    the last bit happened to help (0.0465 m unperturbed, 0.0345 m with seed 1); measured
+    now 0.0346 m for both."""
+    e = _relations_error(real_data, "aces", odometry_noise_seed=seed)
+    assert e.trans_mean <= 0.040, f"seed {seed}: {e.trans_mean:.4f} m"

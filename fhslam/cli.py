@@ -56,6 +56,7 @@ _OFFSET_SOURCES = {
     "laser pose": "from the laser poses of the log's laser lines",
     "none": "none stated in the log: the laser at the robot's origin",
     "tf_static": "from the bag's /tf_static base_link -> laser (zero if none)",
+    "dataset": "the dataset's correction of its file's mount (fhslam.datasets.MOUNT_NOTES)",
     None: "source not recorded by the reader",
 }
 

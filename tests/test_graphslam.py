@@ -141,7 +141,7 @@ REAL_LOGS = {
     "intel": (0.05, 0.0135),
     "aces": (0.06, 0.0346),
     "mit-csail": (0.06, 0.0270),
-    "fr079": (0.08, 0.0643),
+    "fr079": (0.08, 0.0303),
     "fr-clinic": (0.15, 2.47),
 }
 
@@ -171,15 +171,18 @@ def test_mit_csail_does_not_turn_on_the_last_bit(real_data, seed):
     assert e.trans_mean <= 0.035, f"seed {seed}: {e.trans_mean:.4f} m"
 
 
-def test_mit_csail_survives_dropped_scans(real_data):
+@pytest.mark.parametrize(("name", "every_scan"), [("mit-csail", 0.0270), ("fr079", 0.0303)])
+def test_dropped_scans_change_little(real_data, name, every_scan):
     """10 % of the scans dropped (issue 10: no log's error may change by more than 25 % or
-    1 cm): a 5 Hz laser then turns up to 50 degrees between two scans, into space the local
-    map has not seen. Before the tracker matched such a scan against the previous one, five
-    doubtful scans followed the odometry and forced a keyframe 14-17 degrees off: 0.73 m.
-    Measured now 0.0278 m (0.0269 m with every scan)."""
-    e = _relations_error(real_data, "mit-csail", drop_fraction=0.1)
+    1 cm). MIT CSAIL: a 5 Hz laser then turns up to 50 degrees between two scans, into space
+    the local map has not seen; before the tracker matched such a scan against the previous
+    one, five doubtful scans followed the odometry and forced a keyframe 14-17 degrees off:
+    0.73 m (measured now 0.0278 m). Freiburg 079: with the bag's laser mount (+0.04 m) the
+    result swung between 0.064 m and 0.040 m (measured now 0.0306 m)."""
+    e = _relations_error(real_data, name, drop_fraction=0.1)
     assert e.n_used < e.n_total  # relations at dropped scans cannot be evaluated
-    assert e.trans_mean <= 0.0369, f"{e.trans_mean:.4f} m"  # 0.0269 m + 1 cm
+    bound = max(1.25 * every_scan, every_scan + 0.01)
+    assert e.trans_mean <= bound, f"{name}: {e.trans_mean:.4f} m (every scan {every_scan} m)"
 
 
 @pytest.mark.parametrize("seed", [None, 1])

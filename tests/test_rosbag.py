@@ -141,3 +141,26 @@ def test_an_interlaced_laser_gets_per_scan_bearing_offsets(tmp_path):
         np.testing.assert_allclose(pts[:, 0], 2.0, atol=1e-5)
     with pytest.raises(ValueError, match="per-scan bearing offsets"):
         write_carmen(log, tmp_path / "i.clf")
+
+
+def test_fr079_loaded_as_a_dataset_gets_its_original_mount(real_data, tmp_path):
+    """The bag publishes base_link -> laser x = +0.04 m; the original CARMEN log states
+    ``robot_frontlaser_offset -0.04`` (issue 10, item 4). The relations side with the log
+    (default SLAM: 0.0303 m with -0.04 against 0.0643 m with +0.04), so the dataset loader
+    corrects the mount of the dataset's file, found by name or by file name and size; the
+    reader reports the file as it is, and any other file keeps its own mount."""
+    import shutil
+
+    from fhslam.datasets import MOUNT_NOTES, load_log
+
+    assert "-0.04" in MOUNT_NOTES["fr079"]
+    by_name = load_log("fr079")
+    np.testing.assert_array_equal(by_name.laser_offset, [-0.04, 0.0, 0.0])
+    assert by_name.laser_offset_source == "dataset"
+    copy = tmp_path / "fr079.orig.bag"
+    shutil.copyfile(real_data / "fr079.orig.bag", copy)
+    assert load_log(copy).laser_offset_source == "dataset"
+    renamed = tmp_path / "mine.bag"
+    copy.rename(renamed)
+    np.testing.assert_allclose(load_log(renamed).laser_offset, [0.04, 0.0, 0.0], atol=1e-9)
+    assert load_log("intel").laser_offset_source == "tf_static"  # nothing to correct

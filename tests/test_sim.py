@@ -500,6 +500,26 @@ def test_degrade_clutter_share_ranges_and_hits(paper_log, degraded):
     np.testing.assert_array_equal(degraded.hits[~changed], paper_log.hits[rows][~changed])
 
 
+def test_degrade_keeps_the_lasers_mount_and_per_scan_bearing_offsets(paper_log):
+    """A real log's laser mount (Freiburg hospital 0.22 m) and an interlaced laser's per-scan
+    bearing offsets belong to the log: dropping scans must keep them, the offsets row by row
+    (they were lost once, and a dropped-scan run then saw the laser at the robot's origin)."""
+    from dataclasses import replace
+
+    t = len(paper_log)
+    offsets = np.where(np.arange(t) % 2 == 1, 0.0131, 0.0)  # an interlaced laser
+    log = replace(
+        paper_log,
+        laser_offset=np.array([0.22, 0.0, 0.0]),
+        laser_offset_source="tf_static",
+        angle_offsets=offsets,
+    )
+    out = degrade(log, drop_fraction=0.1, seed=7)
+    np.testing.assert_array_equal(out.laser_offset, [0.22, 0.0, 0.0])
+    assert out.laser_offset_source == "tf_static"
+    np.testing.assert_array_equal(out.angle_offsets, offsets[kept_rows(log, out)])
+
+
 def test_degrade_is_deterministic_per_seed_and_leaves_the_input_alone(paper_log, degraded):
     ranges_before = paper_log.ranges.copy()
     again = degrade(paper_log, drop_fraction=0.1, clutter_fraction=0.05, seed=7)

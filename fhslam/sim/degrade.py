@@ -6,6 +6,8 @@ ground truth and wall hits of a simulated log follow the kept scans.
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 
 from fhslam.io.log import Log
@@ -119,14 +121,14 @@ def degrade(
     keep = np.ones(t, dtype=bool)
     keep[order[:n_drop]] = False
 
-    return Log(
-        name=log.name,
+    # Everything else (the laser's mount, its source, the world) is the log's own.
+    return replace(
+        log,
         timestamps=log.timestamps[keep].copy(),
         ranges=ranges[keep],
         angles=log.angles.copy(),
         odometry=log.odometry[keep].copy(),
-        max_range=log.max_range,
         truth=None if log.truth is None else log.truth[keep].copy(),
         hits=None if hits is None else hits[keep],
-        world=log.world,
+        angle_offsets=None if log.angle_offsets is None else log.angle_offsets[keep].copy(),
     )

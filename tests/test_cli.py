@@ -489,3 +489,29 @@ def test_an_output_that_cannot_be_written_is_one_line_and_leaves_nothing(tmp_pat
     assert r.returncode == 2 and r.stderr.count("\n") == 1
     assert "p.clf: cannot write" in r.stderr
     assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.parametrize("which", ["world", "log", "outputs"])
+def test_an_output_never_overwrites_an_input(tmp_path, which):
+    # issue 13: `simulate W.json --log W.json` overwrote the world, `slam X.clf --trajectory
+    # X.clf` the log; refused now before anything is read or written
+    world = tmp_path / "box.json"
+    world.write_text(
+        json.dumps({"name": "box", "walls": [[0, 0, 6, 0], [6, 0, 6, 4], [6, 4, 0, 4],
+                    [0, 4, 0, 0]], "route": [[1, 1], [5, 1], [5, 3]]})
+    )  # fmt: skip
+    log = tmp_path / "box.clf"
+    assert main(["simulate", str(world), "--log", str(log), "--truth", str(tmp_path / "t")]) == 0
+    before = {p: p.read_bytes() for p in (world, log)}
+    if which == "world":
+        r = run("simulate", str(world), "--log", str(world), "--truth", str(tmp_path / "t2"))
+        assert "--log" in r.stderr and "is the input world file" in r.stderr
+    elif which == "log":
+        r = run("slam", str(log), "--trajectory", str(tmp_path / ".." / tmp_path.name / "box.clf"))
+        assert "--trajectory" in r.stderr and "is the input log" in r.stderr
+    else:
+        r = run("slam", str(log), "--trajectory", str(tmp_path / "o"), "--map", str(tmp_path / "o"))
+        assert "--map" in r.stderr and "also given as --trajectory" in r.stderr
+    assert r.returncode == 2 and "Traceback" not in r.stderr and len(r.stderr.splitlines()) == 1
+    assert {p: p.read_bytes() for p in (world, log)} == before
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["box.clf", "box.json", "t"]

@@ -8,7 +8,7 @@ import pytest
 
 from fhslam.errors import InputError, MissingInputError
 from fhslam.io import read_map, read_trajectory, write_map
-from fhslam.io.files import atomic_output, input_path
+from fhslam.io.files import atomic_output, check_outputs, input_path
 
 
 def test_missing_input_is_missing_input_error_and_file_not_found(tmp_path):
@@ -58,3 +58,36 @@ def test_unreadable_input_names_the_path(tmp_path):
     p.chmod(0)
     with pytest.raises(InputError, match=r"t\.txt: cannot read"):
         read_trajectory(p)
+
+
+def test_check_outputs_refuses_an_input_by_any_name(tmp_path, monkeypatch):
+    log = tmp_path / "run.clf"
+    log.write_text("x\n")
+    os.link(log, tmp_path / "hard.clf")
+    os.symlink(log, tmp_path / "soft.clf")
+    monkeypatch.chdir(tmp_path)
+    for name in (
+        "run.clf",
+        "./run.clf",
+        str(log),
+        "hard.clf",
+        "soft.clf",
+        "../" + tmp_path.name + "/run.clf",
+    ):
+        with pytest.raises(
+            InputError, match=r"--trajectory .*: is the input log; .*nothing was written"
+        ):
+            check_outputs({"--trajectory": name}, {"the input log": log})
+    assert log.read_text() == "x\n"
+
+
+def test_check_outputs_refuses_one_output_twice_and_accepts_distinct_ones(tmp_path):
+    with pytest.raises(InputError, match=r"--map .*t\.txt: also given as --trajectory"):
+        check_outputs({"--trajectory": tmp_path / "t.txt", "--map": tmp_path / "t.txt"}, {})
+    # distinct outputs, an output that does not exist yet, options not given, an input
+    # that is not a file (a built-in world's name): all accepted
+    check_outputs(
+        {"--trajectory": tmp_path / "t.txt", "--map": None, "--log": tmp_path / "new.clf"},
+        {"the input world file": None, "the input log": "intel"},
+    )
+    assert not (tmp_path / "t.txt").exists()

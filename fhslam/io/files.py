@@ -7,7 +7,10 @@ Every reader of :mod:`fhslam` opens its file through :func:`input_path` and
   or an unreadable file an :class:`~fhslam.errors.InputError`;
 - an output is written to a temporary file beside it and renamed into place only once
   complete: a failed or interrupted write leaves no half-written file, and an output that
-  cannot be written is an :class:`~fhslam.errors.InputError` naming the path.
+  cannot be written is an :class:`~fhslam.errors.InputError` naming the path;
+- a command checks its outputs with :func:`check_outputs` before it reads or computes
+  anything: an output that is one of its inputs (or another output) is refused, so that no
+  input is ever overwritten.
 """
 
 from __future__ import annotations
@@ -20,7 +23,7 @@ from typing import IO
 
 from fhslam.errors import InputError, MissingInputError
 
-__all__ = ["atomic_output", "input_path", "reading"]
+__all__ = ["atomic_output", "check_outputs", "input_path", "reading"]
 
 
 def input_path(path: str | os.PathLike[str], what: str = "") -> Path:
@@ -41,6 +44,49 @@ def input_path(path: str | os.PathLike[str], what: str = "") -> Path:
         kind = "a directory" if p.is_dir() else "not a regular file"
         raise InputError(f"{p}: is {kind}, not a {what}")
     return p
+
+
+def _same_file(a: Path, b: Path) -> bool:
+    """Whether ``a`` and ``b`` name one file (also through links), existing or not."""
+    try:
+        if a.exists() and b.exists():
+            return os.path.samefile(a, b)
+    except OSError:
+        pass
+    return a.resolve() == b.resolve()
+
+
+def check_outputs(
+    outputs: dict[str, str | os.PathLike[str] | None],
+    inputs: dict[str, str | os.PathLike[str] | None],
+) -> None:
+    """Refuse outputs that would overwrite an input or each other.
+
+    ``outputs`` and ``inputs`` map how the user gave each path (an option such as
+    ``"--log"``, or a description such as ``"the world file"``) to the path; ``None``
+    entries (an option not given, an input that is not a file, e.g. a built-in world's
+    name) are skipped.
+
+    Raises
+    ------
+    InputError
+        Naming the output and what it would overwrite; call this before anything is written.
+    """
+    seen: list[tuple[str, Path]] = [
+        (what, Path(p)) for what, p in inputs.items() if p is not None and Path(p).is_file()
+    ]
+    for what, p in outputs.items():
+        if p is None:
+            continue
+        path = Path(p)
+        for other, q in seen:
+            if _same_file(path, q):
+                role = "also given as" if other.startswith("--") else "is"
+                raise InputError(
+                    f"{what} {path}: {role} {other}; an output must not overwrite an input "
+                    "or another output (nothing was written)"
+                )
+        seen.append((what, path))
 
 
 @contextmanager

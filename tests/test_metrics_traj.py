@@ -298,6 +298,11 @@ GOOD = {"sp": [0, 0], "ep": [1, 0], "rho": 0.0, "theta": 1.5707963267948966, "n"
         (json.dumps({"lines": [{**GOOD, "rho": -1.0}]}), r"lines\[0\]: 'rho' must be >= 0"),
         (json.dumps({"lines": [{**GOOD, "n": 2.5}]}), r"lines\[0\]: 'n' must be"),
         (json.dumps({"lines": [GOOD, "oops"]}), r"lines\[1\]: expected an object"),
+        (
+            json.dumps({"lines": [GOOD, {**GOOD, "ep": [1e308, 0]}]}),
+            r"lines\[1\]: 'ep' coordinate 1e\+308 m is beyond the plausible 1e\+06 m",
+        ),
+        (json.dumps({"lines": [{**GOOD, "rho": 2e6}]}), r"lines\[0\]: 'rho' 2e\+06 m is beyond"),
     ],
     ids=[
         "bad-json",
@@ -310,6 +315,8 @@ GOOD = {"sp": [0, 0], "ep": [1, 0], "rho": 0.0, "theta": 1.5707963267948966, "n"
         "negative-rho",
         "fractional-n",
         "not-dict",
+        "huge-coordinate",
+        "huge-rho",
     ],
 )
 def test_malformed_map_names_file_and_line(tmp_path, content, expected):

@@ -28,6 +28,11 @@ from fhslam.lines import Line
 
 _KEYS = ("sp", "ep", "rho", "theta", "n")
 
+MAX_COORDINATE = 1e6
+"""Largest ``|x|``, ``|y|`` or ``rho`` a map file may hold, metres: a thousand kilometres is
+no building, and a coordinate near the float limit (``1e308``) overflows any length or
+distance computed from it (the map error came out ``inf``)."""
+
 
 class MapFormatError(InputError):
     """A malformed map file. The message names the file and, where it applies, the line index
@@ -87,7 +92,13 @@ def _number(value: Any, what: str, where: str) -> float:
 def _point(value: Any, key: str, where: str) -> np.ndarray:
     if not isinstance(value, list) or len(value) != 2:
         raise MapFormatError(f"{where}: {key!r} must be a list [x, y], got {value!r}")
-    return np.array([_number(v, f"{key!r} coordinate", where) for v in value])
+    xy = np.array([_number(v, f"{key!r} coordinate", where) for v in value])
+    if np.abs(xy).max() > MAX_COORDINATE:
+        raise MapFormatError(
+            f"{where}: {key!r} coordinate {np.abs(xy).max():g} m is beyond the plausible "
+            f"{MAX_COORDINATE:g} m"
+        )
+    return xy
 
 
 def _line(d: Any, where: str) -> Line:
@@ -106,6 +117,10 @@ def _line(d: Any, where: str) -> Line:
         raise MapFormatError(f"{where}: 'n' must be a non-negative integer, got {n!r}")
     if rho < 0:
         raise MapFormatError(f"{where}: 'rho' must be >= 0 (Hessian normal form), got {rho!r}")
+    if rho > MAX_COORDINATE:
+        raise MapFormatError(
+            f"{where}: 'rho' {rho:g} m is beyond the plausible {MAX_COORDINATE:g} m"
+        )
     return Line(
         rho=rho,
         theta=float(np.mod(theta, 2 * np.pi)),
@@ -135,7 +150,8 @@ def read_map(path: str | PathLike[str]) -> list[Line]:
     MapFormatError
         If the file is not JSON (naming the text line), has no ``"lines"`` list, or a line
         object lacks a key or holds a non-number, a non-finite number, a negative ``rho``
-        or a non-integer ``n`` (naming the index, ``lines[i]``). A ``theta`` outside
+        or a non-integer ``n``, or a coordinate or ``rho`` beyond :data:`MAX_COORDINATE`
+        (naming the index, ``lines[i]``). A ``theta`` outside
         [0, 2 pi) is wrapped into it.
     """
     path = input_path(path, "map")

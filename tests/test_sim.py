@@ -311,6 +311,21 @@ def test_load_world_missing_file(tmp_path):
         ('{"walls": [[0, 0, 1, 1]], "route": [[0, 0], [1, 0]], "start": [0, 0]}', "'start'"),
         ('{"walls": [["a", 0, 1, 1]], "route": [[0, 0], [1, 0]]}', "'walls' must be a list"),
         ("[1, 2]", "expected a JSON object"),
+        # the robot cannot drive through a wall: on its route, from a start outside the
+        # building (a RuntimeError from deep in the simulator before), from a start on a wall
+        (
+            '{"walls": [[5, -1, 5, 9]], "route": [[2, 2], [8, 2]]}',
+            r"route.*from \[2.0, 2.0\] to \[8.0, 2.0\] \(a leg of the route\) meets wall row 0",
+        ),
+        (
+            '{"walls": [[0, 0, 9, 0], [9, 0, 9, 9], [9, 9, 0, 9], [0, 9, 0, 0]], '
+            '"route": [[2, 2], [8, 2]], "start": [500, 500, 0]}',
+            r"from \[500.0, 500.0\] to \[2.0, 2.0\] \(start to first waypoint\) meets wall",
+        ),
+        (
+            '{"walls": [[0, 0, 9, 0]], "route": [[2, 2], [8, 2]], "start": [3, 0, 0]}',
+            r"from \[3.0, 0.0\] to \[2.0, 2.0\] \(start to first waypoint\) meets wall row 0",
+        ),
     ],
 )
 def test_load_world_malformed_files_name_file_and_field(tmp_path, content, match):

@@ -136,7 +136,7 @@ def follow_route(
     dt = m.scan_period / m.substeps
     drive_angle = np.radians(m.drive_angle_deg)
     # A generous bound on the scans needed: driving time plus half a turn per waypoint, x3.
-    length = float(np.hypot(*np.diff(route, axis=0).T).sum())
+    length = float(np.hypot(*np.diff(np.vstack([pose[:2], route]), axis=0).T).sum())
     expected = length / m.speed + len(route) * np.pi / m.max_turn_rate
     limit = int(3 * expected / m.scan_period) + 100 if max_scans is None else int(max_scans)
     poses = [pose.copy()]

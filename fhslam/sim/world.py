@@ -107,6 +107,22 @@ class World:
                 )
             if not np.isfinite(start).all():
                 raise WorldFormatError(f"field 'start' is not finite: {start.tolist()}")
+        # The robot drives from the start to the first waypoint, then along the route: a
+        # leg through a wall would put it on the far side of it without a word.
+        legs = np.vstack([start[:2], route])
+        legs = np.hstack([legs[:-1], legs[1:]])
+        legs = legs[np.hypot(legs[:, 2] - legs[:, 0], legs[:, 3] - legs[:, 1]) > 0]
+        if len(legs):
+            hit = segment_distances(legs, walls) < 1e-9
+            if hit.any():
+                k, j = (int(v[0]) for v in np.nonzero(hit))
+                a, b = legs[k, :2].tolist(), legs[k, 2:].tolist()
+                first = k == 0 and self.start is not None
+                leg = "start to first waypoint" if first else "a leg of the route"
+                raise WorldFormatError(
+                    f"field 'route': the robot's way from {a} to {b} ({leg}) meets wall row "
+                    f"{j} {walls[j].tolist()}; a robot cannot drive through walls"
+                )
         for attr, value in (("walls", walls), ("route", route), ("start", start)):
             value.flags.writeable = False
             object.__setattr__(self, attr, value)

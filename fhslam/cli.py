@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import argparse
 import sys
+import warnings
 from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
@@ -458,12 +459,19 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+def _show_warning(message, category, filename, lineno, file=None, line=None) -> None:
+    print(f"fhslam: warning: {' '.join(str(message).split())}", file=sys.stderr)
+
+
 def main(argv: list[str] | None = None) -> int:
     from fhslam.errors import InputError
 
     args = build_parser().parse_args(argv)
     try:
-        args.run(args)
+        with warnings.catch_warnings():
+            # implausible but readable input: one line each, the input named
+            warnings.showwarning = _show_warning
+            args.run(args)
     except InputError as e:  # bad input; anything else is a bug and keeps its traceback
         message = " ".join(str(e).split())  # one line, whatever the message
         print(f"fhslam: error: {message}", file=sys.stderr)

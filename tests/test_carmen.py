@@ -633,3 +633,54 @@ def test_written_log_without_mount_states_zero(sim_log, tmp_path):
     write_carmen(sim_log, path)
     back = _read_quietly(path)
     assert back.laser_offset.tolist() == [0.0, 0.0, 0.0] and back.laser_offset_source == "PARAM"
+
+
+def _flaser(t: float, x: float) -> str:
+    ranges = " ".join(["2.5"] * 5)
+    return f"FLASER 5 {ranges} {x} 0 0 {x} 0 0 {t} host {t}"
+
+
+@pytest.mark.parametrize(
+    ("times", "xs", "message"),
+    [
+        # issue 13: read silently before, one demonstrably corrupting the evaluation
+        (
+            [0.0, 0.2, 0.1, 0.3],
+            [0, 0.1, 0.2, 0.3],
+            r"t\.clf:3: time goes backwards from the "
+            r"scan on line 2 \(0\.2 -> 0\.1\); read as it is",
+        ),
+        (
+            [0.0, 0.2, 0.2, 0.2],
+            [0, 0.1, 0.2, 0.3],
+            r"t\.clf:3: the timestamp repeats from the "
+            r"scan on line 2 \(0\.2 -> 0\.2\) \(and at 1 more scans\)",
+        ),
+        (
+            [0.0, 0.2, 0.4, 0.6],
+            [0, 0.1, 1e6, 0.3],
+            r"t\.clf:3: the odometry jumps more than 10 m "
+            r"from the scan on line 2 \(1e\+06 m\) \(and at 1 more scans\)",
+        ),
+    ],
+    ids=["backwards", "repeated", "odometry-jump"],
+)
+def test_implausible_sequences_are_read_with_a_warning_naming_the_line(
+    tmp_path, times, xs, message
+):
+    path = tmp_path / "t.clf"
+    path.write_text("\n".join(_flaser(t, x) for t, x in zip(times, xs, strict=True)) + "\n")
+    with pytest.warns(CarmenWarning, match=message) as record:
+        log = read_carmen(path)
+    assert len(record) == 1
+    # documented acceptance: the scans as they are, in file order
+    np.testing.assert_array_equal(log.timestamps, times)
+    np.testing.assert_array_equal(log.odometry[:, 0], xs)
+
+
+def test_a_plausible_log_reads_without_warnings(tmp_path):
+    path = tmp_path / "t.clf"
+    path.write_text("\n".join(_flaser(0.2 * k, 0.1 * k) for k in range(5)) + "\n")
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        assert len(read_carmen(path)) == 5

@@ -515,3 +515,17 @@ def test_an_output_never_overwrites_an_input(tmp_path, which):
     assert r.returncode == 2 and "Traceback" not in r.stderr and len(r.stderr.splitlines()) == 1
     assert {p: p.read_bytes() for p in (world, log)} == before
     assert sorted(p.name for p in tmp_path.iterdir()) == ["box.clf", "box.json", "t"]
+
+
+def test_an_implausible_log_warns_in_one_line_and_goes_on(tmp_path):
+    path = tmp_path / "t.clf"
+    ranges = " ".join(["2.5"] * 5)
+    path.write_text(
+        "".join(f"FLASER 5 {ranges} 0 0 0 0 0 0 {t} host {t}\n" for t in (0.0, 0.4, 0.2))
+    )
+    r = run("info", str(path))
+    assert r.returncode == 0 and "Traceback" not in r.stderr
+    assert r.stderr.splitlines() == [
+        f"fhslam: warning: {path}:3: time goes backwards from the scan on line 2 (0.4 -> 0.2); "
+        "read as it is"
+    ]

@@ -468,6 +468,35 @@ def _laser_mount(
     return from_params, "PARAM"
 
 
+ODOMETRY_JUMP = 10.0
+"""An odometry step longer than this between two scans (metres) is implausible: warned."""
+
+
+def _check_sequence(path, t: NDArray[np.float64], odo: NDArray[np.float64], lines) -> None:
+    """Warn (:class:`CarmenWarning`, naming the file and lines) where the scans' time runs
+    backwards or stands still, or the odometry jumps further than :data:`ODOMETRY_JUMP`. The
+    log is read as it is (scans in file order): SLAM goes on (its tracker treats a jump as an
+    odometry glitch), but trajectories and relations are matched by timestamp."""
+    dt = np.diff(t)
+    step = np.hypot(*np.diff(odo[:, :2], axis=0).T)
+    for bad, what in (
+        (dt < 0, "time goes backwards"),
+        (dt == 0, "the timestamp repeats"),
+        (step > ODOMETRY_JUMP, f"the odometry jumps more than {ODOMETRY_JUMP:g} m"),
+    ):
+        if bad.any():
+            k = int(np.flatnonzero(bad)[0])
+            more = f" (and at {int(bad.sum()) - 1} more scans)" if bad.sum() > 1 else ""
+            a, b = float(t[k]), float(t[k + 1])
+            detail = f"{a!r} -> {b!r}" if "jumps" not in what else f"{step[k]:.6g} m"
+            warnings.warn(
+                f"{path}:{lines[k + 1]}: {what} from the scan on line {lines[k]} ({detail})"
+                f"{more}; read as it is",
+                CarmenWarning,
+                stacklevel=3,
+            )
+
+
 def _flaser_layout(path, params: dict[str, _Param], n: int, first: int) -> NDArray[np.float64]:
     """The bearings of the ``FLASER`` scans of ``n`` beams (first line ``first``), from the
     resolution and field-of-view ``PARAM`` lines if stated (:func:`flaser_angles`)."""
@@ -539,6 +568,7 @@ def read_carmen(path: str | PathLike[str], max_range: float | None = None) -> Lo
     """
     path = input_path(path, "CARMEN log")
     stamps: list[float] = []
+    scan_lines: list[int] = []  # the line of each scan, for warnings
     ranges: list[NDArray] = []
     odometry: list[NDArray] = []
     laser_poses: list[NDArray] = []
@@ -577,6 +607,7 @@ def read_carmen(path: str | PathLike[str], max_range: float | None = None) -> Lo
                         f" from the first scan's {first[3][:2]} (line {first[1]})"
                     )
                 stamps.append(stamp)
+                scan_lines.append(lineno)
                 ranges.append(r)
                 odometry.append(odom)
                 laser_poses.append(laser_pose)
@@ -594,6 +625,7 @@ def read_carmen(path: str | PathLike[str], max_range: float | None = None) -> Lo
         angles = geom[0] + np.arange(n) * geom[1]
         inferred, _ = effective_max_range(r, float(geom[2]), float(geom[2]))
     odo = np.vstack(odometry)
+    _check_sequence(path, np.array(stamps), odo, scan_lines)
     mount, source = _laser_mount(path, kind, params, odo, np.vstack(laser_poses))
     return Log(
         name=path.stem,

@@ -18,6 +18,9 @@ EXIT_BAD_INPUT = 2
 SLAM_METHODS = ("fht", "graph", "classical", "ekf", "odometry")
 """The ``--method`` choices of ``slam`` and ``bench`` (:data:`fhslam.pipeline.METHODS`)."""
 
+MAX_LAPS = 100
+"""Largest ``simulate --laps``: a hundred laps of the paper world are 92,000 scans."""
+
 PROFILE_TOP = 25
 """Functions listed by ``--profile``."""
 
@@ -28,17 +31,29 @@ PROFILE_HELP = (
 
 
 def _simulate(args: argparse.Namespace) -> None:
+    from fhslam.errors import InputError
     from fhslam.io import write_carmen, write_trajectory
     from fhslam.io.files import check_outputs
     from fhslam.sim import OdometryNoise, load_world, simulate
+    from fhslam.sim.simulate import is_closed_route
     from fhslam.sim.world import BUILTIN_WORLDS
 
+    if args.seed < 0:
+        raise InputError(f"--seed must be a non-negative integer, got {args.seed}")
+    if not 1 <= args.laps <= MAX_LAPS:
+        raise InputError(f"--laps must be between 1 and {MAX_LAPS}, got {args.laps}")
     builtin = args.world in BUILTIN_WORLDS or args.world.startswith("random:")
     check_outputs(
         {"--log": args.log, "--truth": args.truth},
         {"the input world file": None if builtin else args.world},
     )
     world = load_world(args.world)
+    if args.laps > 1 and not is_closed_route(world.route):
+        raise InputError(
+            f"--laps {args.laps}: world {world.name!r} has an open route (from "
+            f"{world.route[0].tolist()} to {world.route[-1].tolist()}); only a closed route "
+            "can be driven more than once"
+        )
     noise = OdometryNoise.drifting() if args.odometry == "drifting" else OdometryNoise()
     log = simulate(world, seed=args.seed, odometry=noise, laps=args.laps)
     write_carmen(log, args.log)
@@ -328,7 +343,12 @@ def build_parser() -> argparse.ArgumentParser:
         default="default",
         help="odometry noise: default (~1 m drift on the paper route) or drifting (2-6 m)",
     )
-    p.add_argument("--laps", type=int, default=1, help="drive a closed route this many times")
+    p.add_argument(
+        "--laps",
+        type=int,
+        default=1,
+        help=f"drive a closed route this many times (1 to {MAX_LAPS})",
+    )
     p.set_defaults(run=_simulate)
 
     p = sub.add_parser("slam", help="run SLAM on a log: trajectory and line map")

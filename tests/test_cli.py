@@ -529,3 +529,22 @@ def test_an_implausible_log_warns_in_one_line_and_goes_on(tmp_path):
         f"fhslam: warning: {path}:3: time goes backwards from the scan on line 2 (0.4 -> 0.2); "
         "read as it is"
     ]
+
+
+@pytest.mark.parametrize(
+    ("options", "message"),
+    [
+        # issue 13: each was a traceback from deep inside the simulator or NumPy
+        (["--seed", "-1"], "--seed must be a non-negative integer, got -1"),
+        (["--laps", "0"], "--laps must be between 1 and 100, got 0"),
+        (["--laps", "100000"], "--laps must be between 1 and 100, got 100000"),
+        (["--laps", "2"], "--laps 2: world 'paper' has an open route"),
+    ],
+)
+def test_simulate_bad_options_are_one_line_exit_2(tmp_path, options, message):
+    r = run("simulate", "paper", *options, "--log", str(tmp_path / "x.clf"), "--truth",
+            str(tmp_path / "x.txt"))  # fmt: skip
+    assert r.returncode == 2 and "Traceback" not in r.stderr
+    assert len(r.stderr.splitlines()) == 1 and r.stderr.startswith("fhslam: error: ")
+    assert message in r.stderr
+    assert list(tmp_path.iterdir()) == []

@@ -232,3 +232,22 @@ def test_the_filter_runs_in_the_frame_of_its_first_pose():
     np.testing.assert_allclose(slam.anchor, [5.0, -3.0, 1.0])
     np.testing.assert_allclose(slam.ekf.x[:3], [0.5, 0.0, 0.1], atol=1e-15)
     np.testing.assert_allclose(slam.pose, compose([5.0, -3.0, 1.0], [0.5, 0.0, 0.1]), atol=1e-15)
+
+
+def test_the_landmark_limit_bounds_the_state_and_warns_once():
+    # issue 13: the dense covariance made a step cost 1.5 s at several hundred landmarks
+    from fhslam.pipeline import run_slam
+    from fhslam.sim import load_world, simulate
+    from fhslam.slam.ekf import EKFLandmarkLimitWarning, EKFParams
+
+    log = simulate(load_world("random:105"), seed=0)
+    free = run_slam(log, "ekf")
+    n_free = len(free.map)
+    assert n_free >= 10
+    with pytest.warns(EKFLandmarkLimitWarning, match="max_landmarks = 4 landmarks") as record:
+        capped = run_slam(log, "ekf", EKFParams(max_landmarks=4))
+    assert len(record) == 1  # once, not at every refused line
+    assert len(capped.map) == 4 and capped.poses.shape == free.poses.shape
+    assert np.all(np.isfinite(capped.poses))
+    # the default limit leaves a simulated world's map alone (10-20 landmarks)
+    assert EKFParams().max_landmarks > 2 * n_free

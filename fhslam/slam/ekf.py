@@ -30,6 +30,7 @@ sign with it.
 
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -52,6 +53,7 @@ from fhslam.slam.base import FinalEstimate, StepResult
 
 __all__ = [
     "CHI2_2DOF_99",
+    "EKFLandmarkLimitWarning",
     "EKFLineSLAM",
     "EKFParams",
     "line_covariance",
@@ -91,6 +93,12 @@ class EKFParams:
         Shortest line (metres) that starts a landmark.
     min_landmark_points : int
         Fewest points for a line to start a landmark.
+    max_landmarks : int
+        Largest number of landmarks. The filter's covariance is dense, so a step costs
+        O(landmarks²) to O(landmarks³) (1.5 s per scan at several hundred landmarks, on MIT
+        CSAIL an estimated 35 minutes in all); once the map holds this many, new lines start
+        no landmark (they are still matched with the existing ones) and a
+        :class:`EKFLandmarkLimitWarning` says so, once. The simulated worlds need 10-20.
     """
 
     extraction: ExtractionParams = field(default_factory=ExtractionParams)
@@ -103,6 +111,11 @@ class EKFParams:
     new_gate: float = 50.0
     min_landmark_length: float = 0.8
     min_landmark_points: int = 10
+    max_landmarks: int = 150
+
+
+class EKFLandmarkLimitWarning(UserWarning):
+    """The EKF baseline's map reached :attr:`EKFParams.max_landmarks`: no more landmarks."""
 
 
 # --------------------------------------------------------------------------- models
@@ -193,6 +206,7 @@ class EKFLineSLAM:
         self._last_odometry: NDArray | None = None
         self._ends: list[NDArray] = []  # per landmark: its two extreme observed points (2, 2)
         self._support: list[int] = []
+        self._limit_warned = False
 
     @property
     def pose(self) -> NDArray[np.float64]:
@@ -295,6 +309,17 @@ class EKFLineSLAM:
             ln = lines[i]
             long_enough = ln.length >= pr.min_landmark_length and ln.n >= pr.min_landmark_points
             if (j < 0 or d2 > pr.new_gate) and long_enough:
+                if self.n_landmarks >= pr.max_landmarks:
+                    if not self._limit_warned:
+                        self._limit_warned = True
+                        warnings.warn(
+                            f"EKF baseline: the map holds EKFParams.max_landmarks = "
+                            f"{pr.max_landmarks} landmarks (its covariance is dense: each more "
+                            "slows every step); from here on new lines start no landmark",
+                            EKFLandmarkLimitWarning,
+                            stacklevel=2,
+                        )
+                    continue
                 self._add_landmark(ln, covs[i])
                 added += 1
         return len(matched), added

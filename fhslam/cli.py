@@ -230,6 +230,7 @@ def _profiling(enabled: bool) -> Iterator[None]:
 
 def _slam(args: argparse.Namespace) -> None:
     import fhslam.datasets  # noqa: F401  (imported before --profile starts: not what it shows)
+    from fhslam.errors import InputWarning
     from fhslam.io import write_map, write_trajectory
     from fhslam.io.files import check_outputs
     from fhslam.pipeline import run_slam
@@ -237,6 +238,13 @@ def _slam(args: argparse.Namespace) -> None:
     check_outputs({"--trajectory": args.trajectory, "--map": args.map}, {"the input log": args.log})
     with _profiling(args.profile):
         log = _load(args)
+        if len(log) == 1:
+            warnings.warn(
+                f"{args.log}: a single scan: nothing to match it with; the trajectory is its "
+                "odometry pose",
+                InputWarning,
+                stacklevel=1,
+            )
         result = run_slam(log, args.method, progress=not args.quiet and len(log) > 200)
         # Everything is computed before anything is written: bad input leaves no half files.
         write_trajectory(
@@ -480,7 +488,14 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def _show_warning(message, category, filename, lineno, file=None, line=None) -> None:
-    print(f"fhslam: warning: {' '.join(str(message).split())}", file=sys.stderr)
+    """Every warning as one line on stderr. The package's warnings about its input
+    (:class:`fhslam.errors.InputWarning`, and other ``UserWarning``\\s it issues, e.g. the
+    EKF baseline's landmark limit) name the file themselves; any other (a NumPy overflow, a
+    SciPy ill-conditioned matrix) also gets its category and the code that raised it."""
+    text = " ".join(str(message).split())
+    if not issubclass(category, UserWarning):
+        text += f" [{category.__name__} at {Path(filename).name}:{lineno}]"
+    print(f"fhslam: warning: {text}", file=sys.stderr)
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -9,7 +9,7 @@ other type is a bug inside the package and shows its traceback.
 
 from __future__ import annotations
 
-__all__ = ["InputError", "MissingInputError"]
+__all__ = ["InputError", "InputWarning", "MissingInputError"]
 
 
 class InputError(ValueError):
@@ -27,3 +27,10 @@ class MissingInputError(FileNotFoundError, InputError):
 
     def __str__(self) -> str:  # the message, not OSError's "[Errno ...] ..." layout
         return str(self.args[0])
+
+
+class InputWarning(UserWarning):
+    """Readable but implausible input, read as documented (time running backwards, an
+    odometry jump, readings no laser gives, a scan without a return). The message names the
+    file and, where it applies, the line; the ``fhslam`` command prints it as one line
+    ``fhslam: warning: ...`` and goes on."""

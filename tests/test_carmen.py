@@ -636,7 +636,7 @@ def test_written_log_without_mount_states_zero(sim_log, tmp_path):
 
 
 def _flaser(t: float, x: float) -> str:
-    ranges = " ".join(["2.5"] * 5)
+    ranges = "2.5 2.6 2.7 2.8 2.9"  # (all alike would read as the no-return code)
     return f"FLASER 5 {ranges} {x} 0 0 {x} 0 0 {t} host {t}"
 
 
@@ -654,13 +654,13 @@ def _flaser(t: float, x: float) -> str:
             [0.0, 0.2, 0.2, 0.2],
             [0, 0.1, 0.2, 0.3],
             r"t\.clf:3: the timestamp repeats from the "
-            r"scan on line 2 \(0\.2 -> 0\.2\) \(and at 1 more scans\)",
+            r"scan on line 2 \(0\.2 -> 0\.2\) \(and at 1 more scan\)",
         ),
         (
             [0.0, 0.2, 0.4, 0.6],
             [0, 0.1, 1e6, 0.3],
             r"t\.clf:3: the odometry jumps more than 10 m "
-            r"from the scan on line 2 \(1e\+06 m\) \(and at 1 more scans\)",
+            r"from the scan on line 2 \(1e\+06 m\) \(and at 1 more scan\)",
         ),
     ],
     ids=["backwards", "repeated", "odometry-jump"],
@@ -684,3 +684,28 @@ def test_a_plausible_log_reads_without_warnings(tmp_path):
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         assert len(read_carmen(path)) == 5
+
+
+@pytest.mark.parametrize("value", ["nan", "inf", "-1.5", "1e308", "5000"])
+def test_readings_no_laser_gives_are_no_returns_with_a_warning(tmp_path, value):
+    """Issue 13: a 1e308 reading made the maximum range 1e308 m and the reading a point
+    1e308 m away; NaN, inf and negative readings were dropped without a word."""
+    rows = [[2.0, 2.1, 2.2, 2.3, 2.4 + 0.1 * k] for k in range(3)]
+    path = tmp_path / "t.clf"
+    path.write_text(_flaser_log(rows).replace("2.2 2.3", f"2.2 {value}", 1))
+    with pytest.warns(CarmenWarning, match=r"t\.clf:1: 1 reading in 1 scan is negative"):
+        log = read_carmen(path)
+    assert log.max_range == 80.0  # CARMEN's FLASER default: no no-return code in this log
+    assert len(log.scan(0).points()[0]) == 4 and len(log.scan(1).points()[0]) == 5
+
+
+def test_scans_without_a_return_are_named(tmp_path):
+    rows = [[2.0, 2.1, 2.2], [81.91] * 3, [81.91] * 3, [2.0, 2.1, 2.2]] + [[81.91] * 3] * 20
+    path = tmp_path / "t.clf"
+    path.write_text(_flaser_log(rows))
+    with pytest.warns(
+        CarmenWarning,
+        match=r"t\.clf:2: 22 of 24 scans have no return below the maximum range 81.91 m",
+    ) as rec:
+        log = read_carmen(path)
+    assert len(rec) == 1 and log.max_range == pytest.approx(81.91)

@@ -519,7 +519,7 @@ def test_an_output_never_overwrites_an_input(tmp_path, which):
 
 def test_an_implausible_log_warns_in_one_line_and_goes_on(tmp_path):
     path = tmp_path / "t.clf"
-    ranges = " ".join(["2.5"] * 5)
+    ranges = "2.5 2.6 2.7 2.8 2.9"
     path.write_text(
         "".join(f"FLASER 5 {ranges} 0 0 0 0 0 0 {t} host {t}\n" for t in (0.0, 0.4, 0.2))
     )

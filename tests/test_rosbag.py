@@ -15,19 +15,24 @@ def _types():
     return get_typestore(Stores.ROS1_NOETIC)
 
 
-def write_bag(path, scans=3, odom=True, scan_topics=("/scan",), beams=181, interlaced=False):
+def write_bag(
+    path, scans=3, odom=True, scan_topics=("/scan",), beams=181, interlaced=False, stamps=None
+):
     """A tiny ROS 1 bag: scans of a wall 2 m ahead, odometry moving 0.1 m per scan.
     ``interlaced``: scan k starts (k mod 4) quarter-beams later, with one beam fewer after
-    the first (as the Freiburg hospital log's laser)."""
+    the first (as the Freiburg hospital log's laser). ``stamps``: the scans' (and odometry's)
+    header stamps in whole seconds (default 10, 11, ...; the bag records message k at 10 + k s)."""
     from rosbags.rosbag1 import Writer
 
     ts = _types()
     T = ts.types
     scan_t, odom_t = "sensor_msgs/msg/LaserScan", "nav_msgs/msg/Odometry"
 
+    stamps = [10 + k for k in range(scans)] if stamps is None else list(stamps)
+
     def header(k):
         return T["std_msgs/msg/Header"](
-            seq=k, stamp=T["builtin_interfaces/msg/Time"](sec=10 + k, nanosec=0), frame_id="x"
+            seq=k, stamp=T["builtin_interfaces/msg/Time"](sec=stamps[k], nanosec=0), frame_id="x"
         )
 
     with Writer(path) as w:
@@ -164,3 +169,20 @@ def test_fr079_loaded_as_a_dataset_gets_its_original_mount(real_data, tmp_path):
     copy.rename(renamed)
     np.testing.assert_allclose(load_log(renamed).laser_offset, [0.04, 0.0, 0.0], atol=1e-9)
     assert load_log("intel").laser_offset_source == "tf_static"  # nothing to correct
+
+
+def test_scans_out_of_time_order_are_sorted_with_a_warning(tmp_path):
+    """Issue 13: a bag's scans whose header stamps go back in time were sorted silently."""
+    from fhslam.io import BagWarning
+
+    path = write_bag(tmp_path / "b.bag", scans=5, stamps=[10, 11, 13, 12, 12])
+    with pytest.warns(BagWarning) as rec:
+        log = read_bag(path)
+    messages = [str(w.message) for w in rec]
+    assert len(messages) == 2
+    assert (
+        "b.bag: the header stamp goes back in time at 1 scan of the bag (first: scan 3"
+        in messages[0]
+    )
+    assert "b.bag: scan 3: the timestamp repeats from scan 2 (12.0 -> 12.0)" in messages[1]
+    np.testing.assert_array_equal(log.timestamps, [10, 11, 12, 12, 13])

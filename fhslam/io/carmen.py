@@ -77,10 +77,16 @@ from os import PathLike
 import numpy as np
 from numpy.typing import NDArray
 
-from fhslam.errors import InputError
+from fhslam.errors import InputError, InputWarning
 from fhslam.geometry import compose, relative, wrap_angle
 from fhslam.io.files import atomic_output, input_path, reading
-from fhslam.io.log import Log, effective_max_range, is_number
+from fhslam.io.log import (
+    Log,
+    check_readings,
+    check_sequence,
+    effective_max_range,
+    is_number,
+)
 
 HOSTNAME = "fhslam"
 FLASER_MAX_RANGE = 80.0
@@ -91,7 +97,7 @@ class CarmenFormatError(InputError):
     """A malformed CARMEN log. The message reads ``"{path}:{lineno}: {what is wrong}"``."""
 
 
-class CarmenWarning(UserWarning):
+class CarmenWarning(InputWarning):
     """A CARMEN log that contradicts itself, e.g. a ``PARAM`` mount its laser poses disagree
     with (the reader goes on with the rule of the module docstring)."""
 
@@ -468,35 +474,6 @@ def _laser_mount(
     return from_params, "PARAM"
 
 
-ODOMETRY_JUMP = 10.0
-"""An odometry step longer than this between two scans (metres) is implausible: warned."""
-
-
-def _check_sequence(path, t: NDArray[np.float64], odo: NDArray[np.float64], lines) -> None:
-    """Warn (:class:`CarmenWarning`, naming the file and lines) where the scans' time runs
-    backwards or stands still, or the odometry jumps further than :data:`ODOMETRY_JUMP`. The
-    log is read as it is (scans in file order): SLAM goes on (its tracker treats a jump as an
-    odometry glitch), but trajectories and relations are matched by timestamp."""
-    dt = np.diff(t)
-    step = np.hypot(*np.diff(odo[:, :2], axis=0).T)
-    for bad, what in (
-        (dt < 0, "time goes backwards"),
-        (dt == 0, "the timestamp repeats"),
-        (step > ODOMETRY_JUMP, f"the odometry jumps more than {ODOMETRY_JUMP:g} m"),
-    ):
-        if bad.any():
-            k = int(np.flatnonzero(bad)[0])
-            more = f" (and at {int(bad.sum()) - 1} more scans)" if bad.sum() > 1 else ""
-            a, b = float(t[k]), float(t[k + 1])
-            detail = f"{a!r} -> {b!r}" if "jumps" not in what else f"{step[k]:.6g} m"
-            warnings.warn(
-                f"{path}:{lines[k + 1]}: {what} from the scan on line {lines[k]} ({detail})"
-                f"{more}; read as it is",
-                CarmenWarning,
-                stacklevel=3,
-            )
-
-
 def _flaser_layout(path, params: dict[str, _Param], n: int, first: int) -> NDArray[np.float64]:
     """The bearings of the ``FLASER`` scans of ``n`` beams (first line ``first``), from the
     resolution and field-of-view ``PARAM`` lines if stated (:func:`flaser_angles`)."""
@@ -564,7 +541,11 @@ def read_carmen(path: str | PathLike[str], max_range: float | None = None) -> Lo
     Warns
     -----
     CarmenWarning
-        When the ``PARAM`` mount and the constant offset of the laser poses disagree.
+        When the ``PARAM`` mount and the constant offset of the laser poses disagree; where
+        the scans' time runs backwards or repeats or the odometry jumps
+        (:func:`fhslam.io.log.check_sequence`); for readings that are negative, NaN,
+        infinite or beyond 1000 m (read as no return), scans without a return, more than
+        10,000 beams (:func:`fhslam.io.log.check_readings`). Each names the file and line.
     """
     path = input_path(path, "CARMEN log")
     stamps: list[float] = []
@@ -625,7 +606,9 @@ def read_carmen(path: str | PathLike[str], max_range: float | None = None) -> Lo
         angles = geom[0] + np.arange(n) * geom[1]
         inferred, _ = effective_max_range(r, float(geom[2]), float(geom[2]))
     odo = np.vstack(odometry)
-    _check_sequence(path, np.array(stamps), odo, scan_lines)
+    max_range = inferred if max_range is None else float(max_range)
+    check_sequence(path, np.array(stamps), odo, scan_lines, CarmenWarning)
+    check_readings(path, r, max_range, scan_lines, CarmenWarning)
     mount, source = _laser_mount(path, kind, params, odo, np.vstack(laser_poses))
     return Log(
         name=path.stem,
@@ -633,7 +616,7 @@ def read_carmen(path: str | PathLike[str], max_range: float | None = None) -> Lo
         ranges=r,
         angles=angles,
         odometry=odo,
-        max_range=inferred if max_range is None else float(max_range),
+        max_range=max_range,
         laser_offset=mount,
         laser_offset_source=source,
     )

@@ -7,7 +7,8 @@ the same on simulated and real data.
 
 from __future__ import annotations
 
-from collections.abc import Callable
+import warnings
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from os import PathLike
 from typing import Any
@@ -15,7 +16,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from fhslam.errors import InputError
+from fhslam.errors import InputError, InputWarning
 from fhslam.io.files import input_path, reading
 from fhslam.scan import Scan
 
@@ -192,15 +193,130 @@ def effective_max_range(
     """The maximum range a reader gives a log: the smaller of the range the file states
     (``stated``, e.g. a bag's ``range_max``) and its detected no-return code
     (:func:`no_return_reading`); with neither, ``default``, raised above the largest reading
-    if needed so that no real reading is dropped. Returns ``(max_range, code)``."""
-    code = no_return_reading(ranges)
+    if needed so that no real reading is dropped. Never more than :data:`IMPLAUSIBLE_RANGE`:
+    a reading that far is no measurement (:func:`check_readings` warns of it). Returns
+    ``(max_range, code)``."""
+    r = np.asarray(ranges, dtype=float)
+    r = r[np.isfinite(r) & (r < IMPLAUSIBLE_RANGE)]
+    code = no_return_reading(r)
     candidates = [v for v in (stated, code) if v is not None]
     if candidates:
-        return min(candidates), code
+        return min(*candidates, IMPLAUSIBLE_RANGE), code
+    top = float(r.max()) if r.size else 0.0
+    return min(
+        default if default > top else float(np.nextafter(top, np.inf)), IMPLAUSIBLE_RANGE
+    ), None
+
+
+IMPLAUSIBLE_RANGE = 1000.0
+"""No 2D laser scanner measures this far, metres (the longest-range ones reach a few hundred):
+a reading at or beyond it is no measurement. A log's maximum range never exceeds it, so such
+readings count as no return; the readers warn of them (:func:`check_readings`)."""
+
+PLAUSIBLE_BEAMS = 10_000
+"""More beams per scan than any 2D laser scanner gives (the densest give a few thousand): a
+log with more is read, with a warning (its ranges alone take 80 kB per scan)."""
+
+ODOMETRY_JUMP = 10.0
+"""An odometry step longer than this between two scans, metres, is implausible: warned."""
+
+
+def plural(n: int, noun: str) -> str:
+    """``"1 scan"``, ``"2 scans"``: a count for a message."""
+    return f"{n} {noun}" if n == 1 else f"{n} {noun}s"
+
+
+def check_sequence(
+    path: str | PathLike[str],
+    t: NDArray[np.float64],
+    odometry: NDArray[np.float64] | None,
+    lines: Sequence[int] | None,
+    category: type[InputWarning] = InputWarning,
+    noun: str = "scan",
+) -> None:
+    """Warn where successive rows' time runs backwards or stands still, or (``odometry``
+    given) the odometry jumps further than :data:`ODOMETRY_JUMP`: one warning of
+    ``category`` per kind of finding, naming the file, the first place and how many more.
+
+    ``lines`` is the file line of each row (``None``: rows are named by their index, e.g.
+    ``scan 4``). Nothing is changed: the caller reads the input as it is and says so.
+    """
+    t = np.asarray(t, dtype=float)
+    dt = np.diff(t)
+    checks = [(dt < 0, "time goes backwards"), (dt == 0, "the timestamp repeats")]
+    if odometry is not None:
+        step = np.hypot(*np.diff(np.asarray(odometry)[:, :2], axis=0).T)
+        checks.append((step > ODOMETRY_JUMP, f"the odometry jumps more than {ODOMETRY_JUMP:g} m"))
+    for bad, what in checks:
+        if not bad.any():
+            continue
+        k = int(np.flatnonzero(bad)[0])
+        more = f" (and at {plural(int(bad.sum()) - 1, 'more ' + noun)})" if bad.sum() > 1 else ""
+        detail = (
+            f"{step[k]:.6g} m" if "jumps" in what else f"{float(t[k])!r} -> {float(t[k + 1])!r}"
+        )
+        if lines is None:
+            where = f"{path}: {noun} {k + 1}: {what} from {noun} {k}"
+        else:
+            where = f"{path}:{lines[k + 1]}: {what} from the {noun} on line {lines[k]}"
+        warnings.warn(f"{where} ({detail}){more}; read as it is", category, stacklevel=3)
+
+
+def check_readings(
+    path: str | PathLike[str],
+    ranges: NDArray[np.float64],
+    max_range: float,
+    lines: Sequence[int] | None,
+    category: type[InputWarning] = InputWarning,
+    non_finite: bool = True,
+) -> None:
+    """Warn of a log's implausible readings and of scans without a single return.
+
+    One warning of ``category`` for each of: readings that are negative, at or beyond
+    :data:`IMPLAUSIBLE_RANGE`, or (``non_finite``; ROS bags code no return as inf and invalid
+    as NaN, REP 117, so they pass ``False``) NaN or infinite, all read as no return; scans
+    in which no beam returns (nothing to extract or match: SLAM carries the odometry
+    across them); and more beams per scan than :data:`PLAUSIBLE_BEAMS`. Each names the file
+    and the first scan (its file line, or its index when ``lines`` is ``None``).
+    """
     r = np.asarray(ranges, dtype=float)
-    finite = r[np.isfinite(r)]
-    top = float(finite.max()) if finite.size else 0.0
-    return (default if default > top else float(np.nextafter(top, np.inf))), None
+
+    def first(rows: NDArray[np.bool_]) -> str:
+        k = int(np.flatnonzero(rows)[0])
+        return f"{path}:{lines[k]}" if lines is not None else f"{path}: scan {k}"
+
+    with np.errstate(invalid="ignore"):
+        odd = (r < 0) | (r >= IMPLAUSIBLE_RANGE)
+        if non_finite:
+            odd |= ~np.isfinite(r)
+        empty = ~np.any(np.isfinite(r) & (r > 0) & (r < max_range), axis=1)
+    if odd.any():
+        rows = odd.any(axis=1)
+        kinds = "negative, NaN, infinite or" if non_finite else "negative or"
+        n, verb = int(odd.sum()), "is" if odd.sum() == 1 else "are"
+        warnings.warn(
+            f"{first(rows)}: {plural(n, 'reading')} in {plural(int(rows.sum()), 'scan')} "
+            f"{verb} {kinds} beyond {IMPLAUSIBLE_RANGE:g} m (no laser measures that): read as "
+            "no return",
+            category,
+            stacklevel=3,
+        )
+    if empty.any():
+        n = int(empty.sum())
+        which = "no scan has a return" if n == len(r) else f"{n} of {len(r)} scans have no return"
+        warnings.warn(
+            f"{first(empty)}: {which} below the maximum range {max_range:g} m: "
+            "nothing to match there, SLAM carries the odometry across",
+            category,
+            stacklevel=3,
+        )
+    if r.shape[1] > PLAUSIBLE_BEAMS:
+        warnings.warn(
+            f"{path}: {r.shape[1]} beams per scan, more than any 2D laser scanner gives "
+            f"(> {PLAUSIBLE_BEAMS:,}); read as it is",
+            category,
+            stacklevel=3,
+        )
 
 
 def is_number(token: str) -> bool:
@@ -218,7 +334,8 @@ def read_numeric_table(
     error: type[InputError],
     what: str,
     check: Callable[[list[float], str], None] | None = None,
-) -> NDArray[np.float64]:
+    with_lines: bool = False,
+) -> NDArray[np.float64] | tuple[NDArray[np.float64], list[int]]:
     """Rows of a whitespace-separated text file of numbers (``#`` comments, blank lines).
 
     Parameters
@@ -233,13 +350,18 @@ def read_numeric_table(
     check : callable, optional
         ``check(row, where)`` raising ``error`` for a row that is wrong in a file-specific way.
 
+    with_lines : bool
+        Also return the file line of each row.
+
     Returns
     -------
     ndarray, shape (R, len(columns.split()))
+        And, with ``with_lines``, the list of the rows' line numbers.
     """
     path = input_path(path)
     n = len(columns.split())
     rows: list[list[float]] = []
+    linenos: list[int] = []
     try:
         with reading(path), path.open(encoding="utf-8") as f:
             for lineno, line in enumerate(f, start=1):
@@ -259,11 +381,12 @@ def read_numeric_table(
                 if check is not None:
                     check(row, where)
                 rows.append(row)
+                linenos.append(lineno)
     except UnicodeDecodeError as e:
         raise error(f"{path}: not a text file ({e.reason})") from None
     if not rows:
         raise error(f"{path}: no {what} found")
-    return np.array(rows)
+    return (np.array(rows), linenos) if with_lines else np.array(rows)
 
 
 def scan_of(log, k: int) -> tuple[NDArray[np.float64], NDArray[np.float64]]:

@@ -24,17 +24,18 @@ refused. ``beams="bag"`` always takes the bag's values.
 
 from __future__ import annotations
 
+import warnings
 from os import PathLike
 from pathlib import Path
 
 import numpy as np
 from numpy.typing import NDArray
 
-from fhslam.errors import InputError
+from fhslam.errors import InputError, InputWarning
 from fhslam.geometry import wrap_angle
 from fhslam.io.carmen import flaser_angles
 from fhslam.io.files import input_path
-from fhslam.io.log import Log, effective_max_range
+from fhslam.io.log import Log, check_readings, check_sequence, effective_max_range, plural
 
 SCAN_TYPE = "sensor_msgs/msg/LaserScan"
 ODOM_TYPE = "nav_msgs/msg/Odometry"
@@ -42,6 +43,11 @@ ODOM_TYPE = "nav_msgs/msg/Odometry"
 
 class BagFormatError(InputError):
     """A bag that cannot be read as a laser log (names the file and the topic)."""
+
+
+class BagWarning(InputWarning):
+    """A bag that is readable but implausible (scans out of time order, odometry jumps,
+    impossible readings, scans without a return); read as documented, the file named."""
 
 
 def is_bag(path: str | PathLike[str]) -> bool:
@@ -108,6 +114,14 @@ def read_bag(
     BagFormatError
         No scans, no odometry, ambiguous or unknown topics, odometry that does not cover
         the scans, or scans whose angle layouts differ.
+
+    Warns
+    -----
+    BagWarning
+        Scans whose header stamps are out of order in the bag (they are sorted by stamp) or
+        repeat; odometry jumps; negative readings or readings beyond 1000 m (read as no
+        return; NaN and inf are ROS's own codes, REP 117); scans without a return; more
+        than 10,000 beams (:func:`fhslam.io.log.check_readings`).
     """
     from rosbags.highlevel import AnyReader
     from rosbags.typesys import Stores, get_typestore
@@ -163,13 +177,26 @@ def read_bag(
     else:
         max_range = float(max_range_override)
     t = np.asarray(stamps)
+    back = np.diff(t) < 0
+    if back.any():
+        k = int(np.flatnonzero(back)[0])
+        warnings.warn(
+            f"{p}: the header stamp goes back in time at {plural(int(back.sum()), 'scan')} of "
+            f"the bag (first: scan {k + 1}, {t[k + 1]!r} after {t[k]!r}); the scans are sorted "
+            "by stamp",
+            BagWarning,
+            stacklevel=2,
+        )
     order = np.argsort(t, kind="stable")
+    odometry = _interpolate_poses(np.asarray(odo_t), np.asarray(odo), t[order], p)
+    check_sequence(p, t[order], odometry, None, BagWarning)
+    check_readings(p, rr[order], max_range, None, BagWarning, non_finite=False)
     return Log(
         name=p.stem.replace(".orig", ""),
         timestamps=t[order],
         ranges=rr[order],
         angles=angles,
-        odometry=_interpolate_poses(np.asarray(odo_t), np.asarray(odo), t[order], p),
+        odometry=odometry,
         max_range=max_range,
         laser_offset=offset,
         angle_offsets=(np.asarray(starts)[order] - a0) if len(layout) > 1 else None,

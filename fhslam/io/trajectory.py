@@ -12,13 +12,17 @@ from os import PathLike
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from fhslam.errors import InputError
+from fhslam.errors import InputError, InputWarning
 from fhslam.io.files import atomic_output
-from fhslam.io.log import read_numeric_table
+from fhslam.io.log import check_sequence, read_numeric_table
 
 
 class TrajectoryFormatError(InputError):
     """A malformed trajectory file. The message reads ``"{path}:{lineno}: {what is wrong}"``."""
+
+
+class TrajectoryWarning(InputWarning):
+    """A trajectory file whose time runs backwards or repeats (read as it is)."""
 
 
 def write_trajectory(
@@ -78,6 +82,16 @@ def read_trajectory(path: str | PathLike[str]) -> tuple[NDArray[np.float64], NDA
     TrajectoryFormatError
         ``"{path}:{lineno}: ..."`` for a line without exactly 4 fields, a non-numeric or
         non-finite value, or ``"{path}: ..."`` for a file without poses.
+
+    Warns
+    -----
+    TrajectoryWarning
+        Where the timestamps run backwards or repeat (naming the file and line): the file
+        is read as it is. Poses are matched by timestamp in any order; of poses that share
+        a timestamp, the first in the file is the one matched.
     """
-    a = read_numeric_table(path, "timestamp x y theta", TrajectoryFormatError, "poses")
+    a, lines = read_numeric_table(
+        path, "timestamp x y theta", TrajectoryFormatError, "poses", with_lines=True
+    )
+    check_sequence(path, a[:, 0], None, lines, TrajectoryWarning, noun="pose")
     return a[:, 0], a[:, 1:]

@@ -27,6 +27,7 @@ from numpy.typing import ArrayLike, NDArray
 from fhslam.errors import InputError
 from fhslam.geometry import compose, segment_distances, transform_points
 from fhslam.io.files import input_path, reading
+from fhslam.io.mapfile import MAX_COORDINATE
 
 BUILTIN_WORLDS = ("paper", "hall", "corridor", "random:SEED")
 
@@ -51,6 +52,13 @@ def _array(value: Any, field: str, cols: int, min_rows: int) -> NDArray[np.float
     if bad.any():
         i = int(np.flatnonzero(bad)[0])
         raise WorldFormatError(f"field {field!r} row {i} is not finite: {a[i].tolist()}")
+    far = np.abs(a[:, : min(cols, 4)]).max(axis=1) > MAX_COORDINATE
+    if far.any():
+        i = int(np.flatnonzero(far)[0])
+        raise WorldFormatError(
+            f"field {field!r} row {i} lies beyond the plausible {MAX_COORDINATE:g} m: "
+            f"{a[i].tolist()}"
+        )
     return a
 
 
@@ -107,6 +115,11 @@ class World:
                 )
             if not np.isfinite(start).all():
                 raise WorldFormatError(f"field 'start' is not finite: {start.tolist()}")
+            if np.abs(start[:2]).max() > MAX_COORDINATE:
+                raise WorldFormatError(
+                    f"field 'start' lies beyond the plausible {MAX_COORDINATE:g} m: "
+                    f"{start.tolist()}"
+                )
         # The robot drives from the start to the first waypoint, then along the route: a
         # leg through a wall would put it on the far side of it without a word.
         legs = np.vstack([start[:2], route])

@@ -268,24 +268,52 @@ class EKFLineSLAM:
         self.ekf.predict(u=u)
 
     def _associate(self, lines: list[Line], covs: list[NDArray]) -> list[tuple[int, float]]:
-        """Nearest landmark by Mahalanobis distance (χ²) for each line, and that distance."""
+        """Nearest landmark by Mahalanobis distance (χ²) for each line, and that distance
+        (``(-1, inf)``: no landmark whose innovation covariance is positive definite).
+
+        All lines against all landmarks at once: the Jacobian of a landmark's ``ẑ`` is zero
+        but in the robot's three columns and the landmark's two
+        (:func:`measurement_jacobian`), so ``H P Hᵀ`` needs only that 5 x 5 block of ``P``
+        (not the whole dense product, which made a step cost 0.2 s at 150 landmarks); the
+        2 x 2 innovation covariances are inverted in closed form.
+        """
+        m = self.n_landmarks
+        if m == 0:
+            return [(-1, np.inf)] * len(lines)
         x, p = self.ekf.x, self.ekf.P
-        out = []
-        for ln, r in zip(lines, covs, strict=True):
-            best, best_d2 = -1, np.inf
-            z = np.array([ln.theta, ln.rho])
-            for j in range(self.n_landmarks):
-                h = measurement_jacobian(x, j)
-                s = h @ p @ h.T + r
-                y = residual(z, predict_measurement(x, j))
-                try:
-                    d2 = float(y @ np.linalg.solve(s, y))
-                except np.linalg.LinAlgError:
-                    continue
-                if d2 < best_d2:
-                    best, best_d2 = j, d2
-            out.append((best, best_d2))
-        return out
+        a, r = x[3::2], x[4::2]
+        c, s = np.cos(a), np.sin(a)
+        rr = r - (x[0] * c + x[1] * s)
+        sign = np.where(rr < 0, -1.0, 1.0)  # the flipped form's Jacobian row, as predicted
+        h = np.zeros((m, 2, 5))  # columns: x, y, θ, α_j, r_j
+        h[:, 0, 2], h[:, 0, 3] = -1.0, 1.0
+        h[:, 1, 0], h[:, 1, 1] = -c * sign, -s * sign
+        h[:, 1, 3] = (x[0] * s - x[1] * c) * sign
+        h[:, 1, 4] = sign
+        cols = np.empty((m, 5), dtype=np.intp)
+        cols[:, :3] = [0, 1, 2]
+        cols[:, 3] = 3 + 2 * np.arange(m)
+        cols[:, 4] = cols[:, 3] + 1
+        block = p[cols[:, :, None], cols[:, None, :]]  # (m, 5, 5)
+        hph = np.einsum("mik,mkl,mjl->mij", h, block, h)  # (m, 2, 2)
+        zr, za = normalize_line(rr, a - x[2])  # ẑ of every landmark
+        z = np.array([[ln.theta, ln.rho] for ln in lines])  # (L, 2)
+        sm = hph[None] + np.asarray(covs)[:, None]  # (L, m, 2, 2)
+        y = residual(
+            np.repeat(z, m, axis=0), np.tile(np.column_stack([za, zr]), (len(lines), 1))
+        ).reshape(len(lines), m, 2)
+        s00, s01, s10, s11 = sm[..., 0, 0], sm[..., 0, 1], sm[..., 1, 0], sm[..., 1, 1]
+        det = s00 * s11 - s01 * s10
+        ya, yr = y[..., 0], y[..., 1]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            d2 = (s11 * ya * ya - (s01 + s10) * ya * yr + s00 * yr * yr) / det
+        d2 = np.where((det > 0) & (s00 > 0) & np.isfinite(d2), d2, np.inf)
+        best = np.argmin(d2, axis=1)
+        best_d2 = d2[np.arange(len(lines)), best]
+        return [
+            (int(j), float(d)) if np.isfinite(d) else (-1, np.inf)
+            for j, d in zip(best, best_d2, strict=True)
+        ]
 
     def update(self, lines: list[Line], points: NDArray) -> tuple[int, int]:
         """Associate, update with all matched lines at once, add new landmarks.

@@ -484,7 +484,29 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.add_argument("--profile", action="store_true", help=PROFILE_HELP)
     p.set_defaults(run=_bench)
+
+    p = sub.add_parser(
+        "student-copy",
+        help="write the notebooks without their solutions, for a class",
+        description="Copy every notebook of NOTEBOOKS to OUT without the exercise solutions "
+        "(cells tagged 'solution') and without outputs, so that students run them themselves.",
+    )
+    p.add_argument("out", type=Path, help="output folder (created; must not be NOTEBOOKS)")
+    p.add_argument(
+        "--notebooks",
+        type=Path,
+        default=Path("notebooks"),
+        help="folder of the notebooks (default notebooks)",
+    )
+    p.set_defaults(run=_student_copy)
     return parser
+
+
+def _student_copy(args: argparse.Namespace) -> None:
+    from fhslam.exercises import student_copy
+
+    for path, removed in student_copy(args.notebooks, args.out):
+        print(f"{path}: {removed} solution{'s' if removed != 1 else ''} removed")
 
 
 def _show_warning(message, category, filename, lineno, file=None, line=None) -> None:

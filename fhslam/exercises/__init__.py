@@ -1,0 +1,197 @@
+"""The notebooks' exercises: checks that receive the student's answer and say, in one line,
+whether it is right.
+
+Every notebook has at least three exercises of three kinds — *predict-then-check* (a value or a
+choice written down before running the code that shows it), *implement-a-step* (a function the
+method needs) and *interpret-a-result* (a choice about what a figure or table means). Each has
+a check here, ``check_…(answer, ...)``, which returns a :class:`Feedback`, shown as one line:
+
+- ``⏳ not attempted yet: ...`` while the template is unfilled (a function that still raises
+  :class:`NotImplementedError`, a value left as ``...``), so that Run All completes;
+- ``✅ correct: ...`` or ``❌ not yet: ...`` naming the case that failed and a hint.
+
+A student's function that raises is reported the same way, in one line, never as a traceback.
+The checks of notebook ``NN`` live in :mod:`fhslam.exercises.nbNN` (``from
+fhslam.exercises.nb02 import check_clustering``); this module holds what they share.
+
+In the notebooks an exercise is four cells: a markdown cell ``## Exercise N.k (kind) — title``
+with the task; the student's cell (tag ``exercise``: a template that raises
+:class:`NotImplementedError` or sets a value to ``...``); the check cell (tag ``check``,
+calling the check on the student's answer); and the solution cell (tag ``solution``, its input
+and output hidden until asked), which runs the same check on the solution. ``fhslam student-copy``
+(:func:`student_copy`) writes the notebooks without their solution cells.
+"""
+
+from __future__ import annotations
+
+import functools
+from collections.abc import Callable
+from dataclasses import dataclass
+from os import PathLike
+from pathlib import Path
+from typing import Any
+
+__all__ = [
+    "Feedback",
+    "Wrong",
+    "call",
+    "check_choice",
+    "check_value",
+    "exercise",
+    "student_copy",
+]
+
+_MARK = {"correct": "✅ correct", "wrong": "❌ not yet", "not attempted": "⏳ not attempted yet"}
+
+
+@dataclass(frozen=True)
+class Feedback:
+    """The outcome of a check: ``status`` (``"correct"``, ``"wrong"`` or ``"not attempted"``)
+    and a one-line ``message``. Shown as one line; true only when correct."""
+
+    status: str
+    message: str
+
+    def __post_init__(self) -> None:
+        if self.status not in _MARK:
+            raise ValueError(f"status must be one of {sorted(_MARK)}, got {self.status!r}")
+
+    def __str__(self) -> str:
+        return f"{_MARK[self.status]}: {' '.join(self.message.split())}"
+
+    __repr__ = __str__
+
+    def __bool__(self) -> bool:
+        return self.status == "correct"
+
+
+class Wrong(Exception):
+    """Raised inside a check: the answer is wrong; the message says where and why."""
+
+
+class _NotAttempted(Exception):
+    pass
+
+
+def _unfilled(answer: Any) -> bool:
+    return answer is ... or answer is None
+
+
+def call(fn: Callable[..., Any], *args: Any, **kwargs: Any) -> Any:
+    """Call the student's ``fn``: :class:`NotImplementedError` means the template is not
+    filled in yet; any other exception becomes a :class:`Wrong` naming it (one line)."""
+    try:
+        result = fn(*args, **kwargs)
+    except NotImplementedError:
+        raise _NotAttempted from None
+    except Exception as e:  # the student's code: reported, never a traceback
+        name = getattr(fn, "__name__", "your function")
+        raise Wrong(f"{name} raised {type(e).__name__}: {e}") from None
+    if result is ...:
+        raise _NotAttempted
+    return result
+
+
+def exercise(what: str) -> Callable[[Callable[..., str]], Callable[..., Feedback]]:
+    """Turn ``check(answer, *args) -> str`` (the success message; raises :class:`Wrong`)
+    into a check returning :class:`Feedback`. ``what`` says what the student fills in, for
+    the "not attempted yet" line (e.g. ``"my_cluster"``)."""
+
+    def wrap(check: Callable[..., str]) -> Callable[..., Feedback]:
+        @functools.wraps(check)
+        def run(answer: Any, *args: Any, **kwargs: Any) -> Feedback:
+            todo = Feedback("not attempted", f"fill in {what} above, then run this cell again")
+            if _unfilled(answer):
+                return todo
+            try:
+                return Feedback("correct", check(answer, *args, **kwargs))
+            except _NotAttempted:
+                return todo
+            except Wrong as e:
+                return Feedback("wrong", str(e))
+
+        return run
+
+    return wrap
+
+
+def check_value(
+    answer: Any,
+    expected: float,
+    tolerance: float,
+    what: str,
+    unit: str = "",
+    hint: str = "",
+) -> Feedback:
+    """A predicted number: right within ``tolerance`` of ``expected``; ``hint`` is shown
+    when it is not."""
+
+    @exercise(what)
+    def check(answer: Any) -> str:
+        try:
+            value = float(answer)
+        except (TypeError, ValueError):
+            raise Wrong(f"{what} should be a number, got {answer!r}") from None
+        if not abs(value - expected) <= tolerance:
+            raise Wrong(
+                f"{what} = {value:g}{unit} is more than {tolerance:g}{unit} off. {hint}".strip()
+            )
+        return f"{what} = {value:g}{unit} (the value: {expected:.4g}{unit})"
+
+    return check(answer)
+
+
+def check_choice(answer: Any, right: str, why: dict[str, str], what: str = "my_answer") -> Feedback:
+    """A multiple-choice answer, a letter among ``why``'s keys: ``why[letter]`` explains each
+    choice (shown for the one given, right or wrong)."""
+
+    @exercise(what)
+    def check(answer: Any) -> str:
+        letter = str(answer).strip().lower().strip("()")
+        if letter not in why:
+            raise Wrong(f"answer with one of {', '.join(map(repr, why))}, got {answer!r}")
+        if letter != right:
+            raise Wrong(f"({letter}): {why[letter]}")
+        return f"({letter}): {why[letter]}"
+
+    return check(answer)
+
+
+def _is_solution(cell: dict) -> bool:
+    return "solution" in cell.get("metadata", {}).get("tags", [])
+
+
+def student_copy(source: str | PathLike[str], out: str | PathLike[str]) -> list[tuple[Path, int]]:
+    """Write every notebook of folder ``source`` to folder ``out`` without its solution cells
+    (cells tagged ``solution``) and without outputs; returns ``(path, solutions removed)`` per
+    notebook. ``out`` must not be ``source``."""
+    import nbformat
+
+    from fhslam.errors import InputError
+    from fhslam.io.files import atomic_output
+
+    src, dst = Path(source), Path(out)
+    if not src.is_dir():
+        raise InputError(f"{src}: no such folder of notebooks")
+    notebooks = sorted(src.glob("*.ipynb"))
+    if not notebooks:
+        raise InputError(f"{src}: no notebooks (*.ipynb) in this folder")
+    if dst.exists() and dst.resolve() == src.resolve():
+        raise InputError(f"{dst}: is the source folder; the student copy must go elsewhere")
+    dst.mkdir(parents=True, exist_ok=True)
+    written = []
+    for path in notebooks:
+        try:
+            nb = nbformat.read(path, as_version=4)
+        except Exception as e:  # nbformat raises several types for a broken file
+            raise InputError(f"{path}: not a readable notebook ({e})") from None
+        kept = [c for c in nb.cells if not _is_solution(c)]
+        removed = len(nb.cells) - len(kept)
+        nb.cells = kept
+        for c in nb.cells:
+            if c.cell_type == "code":
+                c.outputs, c.execution_count = [], None
+        with atomic_output(dst / path.name) as f:
+            nbformat.write(nb, f)
+        written.append((dst / path.name, removed))
+    return written

@@ -486,6 +486,35 @@ def build_parser() -> argparse.ArgumentParser:
     p.set_defaults(run=_bench)
 
     p = sub.add_parser(
+        "sweep",
+        help="every SLAM method on seeds x odometry-noise levels of a simulated world",
+        description="Simulate WORLD with each seed and odometry-noise level (low, medium, "
+        "high) and run every SLAM method on each log, in parallel; print the median ATE, map "
+        "error and time per level and method. With --out, write every run as CSV: notebook "
+        "07 shows the committed notebooks/results/sweep_paper.csv.",
+    )
+    p.add_argument("--world", default="paper", help="world to simulate (default paper)")
+    p.add_argument("--seeds", type=int, default=20, help="seeds 0..N-1 per level (default 20)")
+    p.add_argument(
+        "--levels",
+        nargs="+",
+        choices=("low", "medium", "high"),
+        default=["low", "medium", "high"],
+        help="odometry-noise levels (default all three)",
+    )
+    p.add_argument(
+        "--methods",
+        nargs="+",
+        choices=SLAM_METHODS,
+        default=list(SLAM_METHODS),
+        help="SLAM methods (default all)",
+    )
+    p.add_argument("--jobs", type=int, default=-1, help="worker processes (default: all cores)")
+    p.add_argument("--out", type=Path, help="write every run to this CSV file")
+    p.add_argument("--quiet", action="store_true", help="no progress bar")
+    p.set_defaults(run=_sweep)
+
+    p = sub.add_parser(
         "student-copy",
         help="write the notebooks without their solutions, for a class",
         description="Copy every notebook of NOTEBOOKS to OUT without the exercise solutions "
@@ -500,6 +529,36 @@ def build_parser() -> argparse.ArgumentParser:
     )
     p.set_defaults(run=_student_copy)
     return parser
+
+
+def _sweep(args: argparse.Namespace) -> None:
+    from fhslam.errors import InputError
+    from fhslam.experiments import compare
+    from fhslam.io.files import check_outputs
+    from fhslam.sim import load_world
+
+    if not 1 <= args.seeds <= 1000:
+        raise InputError(f"--seeds must be between 1 and 1000, got {args.seeds}")
+    if args.jobs == 0:
+        raise InputError("--jobs must not be 0 (-1: all cores)")
+    load_world(args.world)  # a bad world is an error before any worker starts
+    if args.out is not None:  # and an output that cannot be written, before the hours of work
+        check_outputs({"--out": args.out}, {"the world file": args.world})
+        if args.out.is_dir():
+            raise InputError(f"--out {args.out}: is a directory; give a file name")
+        if not args.out.parent.is_dir():
+            raise InputError(f"--out {args.out}: no such folder {args.out.parent}")
+    rows = compare.slam_sweep(
+        world=args.world,
+        seeds=range(args.seeds),
+        levels=args.levels,
+        methods=args.methods,
+        n_jobs=args.jobs,
+        progress=not args.quiet,
+    )
+    if args.out is not None:
+        compare.save_sweep(rows, args.out)
+    print(compare.format_summary(rows))
 
 
 def _student_copy(args: argparse.Namespace) -> None:

@@ -8,14 +8,19 @@ order whatever the backend.
 
 from __future__ import annotations
 
+import csv
+import os
 import time
 from collections.abc import Sequence
-from dataclasses import dataclass, replace
+from dataclasses import astuple, dataclass, fields, replace
+from pathlib import Path
 
 import numpy as np
 from joblib import Parallel, delayed
 from tqdm.auto import tqdm
 
+from fhslam.errors import InputError
+from fhslam.io.files import atomic_output
 from fhslam.metrics import ate, map_error
 from fhslam.pipeline import METHODS, run_slam
 from fhslam.sim import OdometryNoise, load_world, simulate
@@ -125,3 +130,98 @@ def summary(rows: Sequence[RunResult]) -> dict[tuple[str, str], dict[str, float]
             "n": len(sel),
         }
     return out
+
+
+LABELS = {
+    "fht": "FH-SLAM (paper)",
+    "graph": "FH-SLAM graph",
+    "classical": "FH-SLAM + classical Hough",
+    "ekf": "EKF line SLAM",
+    "odometry": "odometry",
+}
+"""How tables and figures name the methods."""
+
+FIELDS = tuple(f.name for f in fields(RunResult))
+"""The columns of a sweep file, in order: one :class:`RunResult` per row."""
+
+
+def format_summary(rows: Sequence[RunResult]) -> str:
+    """The medians of a sweep per level and method, as a table (what ``fhslam sweep`` prints)."""
+    s = summary(rows)
+    levels = [lv for lv in ("low", "medium", "high") if any(k[0] == lv for k in s)]
+    levels += sorted({k[0] for k in s} - set(levels))
+    methods = [m for m in LABELS if any(k[1] == m for k in s)]
+    seeds = len({r.seed for r in rows})
+    lines = [
+        f"{len(rows)} runs: {seeds} seeds x {len(levels)} levels x {len(methods)} methods",
+        f"{'level':7} {'method':26} {'ATE median':>11} {'ATE max':>9} {'map err med':>12} "
+        f"{'ms/step':>8}",
+    ]
+    for lv in levels:
+        for m in methods:
+            if (lv, m) not in s:
+                continue
+            v = s[(lv, m)]
+            me = v["map_error_median"]
+            me_s = "" if np.isnan(me) else f"{100 * me:9.1f} cm"
+            lines.append(
+                f"{lv:7} {LABELS[m]:26} {v['ate_median']:9.3f} m {v['ate_max']:7.3f} m "
+                f"{me_s:>12} {v['ms_per_step_median']:8.2f}"
+            )
+    return "\n".join(lines)
+
+
+def save_sweep(rows: Sequence[RunResult], path: str | os.PathLike[str]) -> None:
+    """Write a sweep as CSV, one :class:`RunResult` per row (columns :data:`FIELDS`), so that
+    a notebook can show the full sweep without running it (``fhslam sweep --out``)."""
+    with atomic_output(path) as f:
+        w = csv.writer(f, lineterminator="\n")
+        w.writerow(FIELDS)
+        for r in rows:
+            w.writerow([repr(v) if isinstance(v, float) else v for v in astuple(r)])
+
+
+def load_sweep(path: str | os.PathLike[str]) -> list[RunResult]:
+    """Read a sweep written by :func:`save_sweep`.
+
+    Raises
+    ------
+    InputError
+        If the file is missing or not a sweep file: a wrong header, a row with another number
+        of fields, an unknown method or level, a number that is not one; naming file and line.
+    """
+    p = Path(path)
+    try:
+        text = p.read_text(encoding="utf-8")
+    except FileNotFoundError:
+        raise InputError(
+            f"{p}: no such sweep file; write it with: fhslam sweep --out {p}"
+        ) from None
+    except (OSError, UnicodeDecodeError) as e:
+        raise InputError(f"{p}: cannot read ({e})") from None
+    reader = csv.reader(text.splitlines())
+    header = next(reader, None)
+    if header is None or tuple(header) != FIELDS:
+        raise InputError(f"{p}:1: not a sweep file (expected the header {','.join(FIELDS)})")
+    types = [f.type for f in fields(RunResult)]
+    rows = []
+    for line, values in enumerate(reader, start=2):
+        if not values:
+            continue
+        if len(values) != len(FIELDS):
+            raise InputError(f"{p}:{line}: {len(values)} fields, expected {len(FIELDS)}")
+        try:
+            kw = {
+                name: (int(v) if t in ("int", int) else float(v) if t in ("float", float) else v)
+                for name, t, v in zip(FIELDS, types, values, strict=True)
+            }
+        except ValueError as e:
+            raise InputError(f"{p}:{line}: not a number ({e})") from None
+        if kw["method"] not in METHODS:
+            raise InputError(f"{p}:{line}: unknown method {kw['method']!r}")
+        if kw["level"] not in noise_levels():
+            raise InputError(f"{p}:{line}: unknown noise level {kw['level']!r}")
+        rows.append(RunResult(**kw))
+    if not rows:
+        raise InputError(f"{p}: no runs in this sweep file")
+    return rows

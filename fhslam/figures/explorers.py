@@ -8,7 +8,8 @@ saying to run the cell, instead of ``interactive(children=(IntSlider(...``. Slid
 released (``continuous_update=False``); every redraw takes well under a second on a 2-core
 machine (each explorer's work is one scan, one pair of lines or one short run).
 
-Each ``*_explorer`` function returns the :class:`Explorer`; ``explorer.set(name=value)`` moves
+Every explorer's first control changes its figure (the browser test moves it). Each
+``*_explorer`` function returns the :class:`Explorer`; ``explorer.set(name=value)`` moves
 a control from code (what the tests do) and ``explorer.figure()`` draws the current state.
 """
 

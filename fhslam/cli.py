@@ -303,14 +303,22 @@ def _bench(args: argparse.Namespace) -> None:
         print(bench.format_log_bench(result))
 
 
-def _positive_metres(text: str) -> float:
-    try:
-        value = float(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"not a number: {text!r}") from None
-    if not (value > 0 and value < float("inf")):
-        raise argparse.ArgumentTypeError(f"must be a positive number of metres, got {text}")
-    return value
+def _positive(unit: str):
+    """An argparse type: a positive finite number of ``unit``."""
+
+    def parse(text: str) -> float:
+        try:
+            value = float(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"not a number: {text!r}") from None
+        if not (value > 0 and value < float("inf")):
+            raise argparse.ArgumentTypeError(f"must be a positive number of {unit}, got {text}")
+        return value
+
+    return parse
+
+
+_positive_metres = _positive("metres")
 
 
 def _log_arguments(p: argparse.ArgumentParser) -> None:
@@ -528,7 +536,46 @@ def build_parser() -> argparse.ArgumentParser:
         help="folder of the notebooks (default notebooks)",
     )
     p.set_defaults(run=_student_copy)
+
+    p = sub.add_parser(
+        "run-notebooks",
+        help="run the notebooks and write them back with fresh outputs and paired .py sources",
+        description="Execute each notebook (all of NOTEBOOKS, or those whose names start with "
+        "the numbers given) in a fresh kernel, in its own folder, and write it back with its "
+        "new outputs and its paired plain-text source (NN_topic.py, jupytext percent format). "
+        "Prints each notebook's Run All time and its slowest cell. A cell that raises stops "
+        "the run with a one-line error naming the notebook and the cell; that notebook is "
+        "left as it was. With --pair-only, nothing is run: only the .py sources are written.",
+    )
+    p.add_argument("only", nargs="*", metavar="NN", help="notebook numbers, e.g. 03 08")
+    p.add_argument(
+        "--notebooks",
+        type=Path,
+        default=Path("notebooks"),
+        help="folder of the notebooks (default notebooks)",
+    )
+    p.add_argument(
+        "--timeout", type=_positive("seconds"), default=600.0, help="seconds per cell (default 600)"
+    )
+    p.add_argument("--pair-only", action="store_true", help="write the .py sources, run nothing")
+    p.set_defaults(run=_run_notebooks)
     return parser
+
+
+def _run_notebooks(args: argparse.Namespace) -> None:
+    from fhslam.errors import InputError
+    from fhslam.workbook import notebooks_in, pair, run_notebook
+
+    found = notebooks_in(args.notebooks)
+    chosen = [p for p in found if not args.only or any(p.name.startswith(n) for n in args.only)]
+    missing = [n for n in args.only if not any(p.name.startswith(n) for p in found)]
+    if missing:
+        raise InputError(f"{args.notebooks}: no notebook starts with {', '.join(missing)}")
+    for path in chosen:
+        if args.pair_only:
+            print(f"{pair(path)}: written")
+        else:
+            print(run_notebook(path, timeout=args.timeout), flush=True)
 
 
 def _sweep(args: argparse.Namespace) -> None:
@@ -562,7 +609,7 @@ def _sweep(args: argparse.Namespace) -> None:
 
 
 def _student_copy(args: argparse.Namespace) -> None:
-    from fhslam.exercises import student_copy
+    from fhslam.workbook import student_copy
 
     for path, removed in student_copy(args.notebooks, args.out):
         print(f"{path}: {removed} solution{'s' if removed != 1 else ''} removed")

@@ -19,7 +19,7 @@ with the task; the student's cell (tag ``exercise``: a template that raises
 :class:`NotImplementedError` or sets a value to ``...``); the check cell (tag ``check``,
 calling the check on the student's answer); and the solution cell (tag ``solution``, its input
 and output hidden until asked), which runs the same check on the solution. ``fhslam student-copy``
-(:func:`student_copy`) writes the notebooks without their solution cells.
+(:func:`fhslam.workbook.student_copy`) writes the notebooks without their solution cells.
 """
 
 from __future__ import annotations
@@ -27,8 +27,6 @@ from __future__ import annotations
 import functools
 from collections.abc import Callable
 from dataclasses import dataclass
-from os import PathLike
-from pathlib import Path
 from typing import Any
 
 __all__ = [
@@ -38,7 +36,6 @@ __all__ = [
     "check_choice",
     "check_value",
     "exercise",
-    "student_copy",
 ]
 
 _MARK = {"correct": "✅ correct", "wrong": "❌ not yet", "not attempted": "⏳ not attempted yet"}
@@ -155,43 +152,3 @@ def check_choice(answer: Any, right: str, why: dict[str, str], what: str = "my_a
         return f"({letter}): {why[letter]}"
 
     return check(answer)
-
-
-def _is_solution(cell: dict) -> bool:
-    return "solution" in cell.get("metadata", {}).get("tags", [])
-
-
-def student_copy(source: str | PathLike[str], out: str | PathLike[str]) -> list[tuple[Path, int]]:
-    """Write every notebook of folder ``source`` to folder ``out`` without its solution cells
-    (cells tagged ``solution``) and without outputs; returns ``(path, solutions removed)`` per
-    notebook. ``out`` must not be ``source``."""
-    import nbformat
-
-    from fhslam.errors import InputError
-    from fhslam.io.files import atomic_output
-
-    src, dst = Path(source), Path(out)
-    if not src.is_dir():
-        raise InputError(f"{src}: no such folder of notebooks")
-    notebooks = sorted(src.glob("*.ipynb"))
-    if not notebooks:
-        raise InputError(f"{src}: no notebooks (*.ipynb) in this folder")
-    if dst.exists() and dst.resolve() == src.resolve():
-        raise InputError(f"{dst}: is the source folder; the student copy must go elsewhere")
-    dst.mkdir(parents=True, exist_ok=True)
-    written = []
-    for path in notebooks:
-        try:
-            nb = nbformat.read(path, as_version=4)
-        except Exception as e:  # nbformat raises several types for a broken file
-            raise InputError(f"{path}: not a readable notebook ({e})") from None
-        kept = [c for c in nb.cells if not _is_solution(c)]
-        removed = len(nb.cells) - len(kept)
-        nb.cells = kept
-        for c in nb.cells:
-            if c.cell_type == "code":
-                c.outputs, c.execution_count = [], None
-        with atomic_output(dst / path.name) as f:
-            nbformat.write(nb, f)
-        written.append((dst / path.name, removed))
-    return written

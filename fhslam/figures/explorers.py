@@ -160,10 +160,13 @@ def clustering_explorer(log: Log, k: int, min_points: int = ExtractionParams().m
 
 
 def extraction_explorer(log: Log, k: int):
-    """Notebook 03: the lines of scan ``k`` under the extraction's thresholds."""
+    """Notebook 03: the lines of scan ``k`` under the extraction's thresholds, the support
+    threshold first (the paper's "until the number to support a certain slope is lower than
+    the threshold"). Each line is marked with its number and its support (scan points); the
+    title gives the count of lines and the thresholds."""
     d = ExtractionParams()
 
-    def draw(scan, cluster_gap, window_deg, inlier_dist, min_points, densify_step) -> Figure:
+    def draw(min_points, window_deg, inlier_dist, cluster_gap, densify_step, scan) -> Figure:
         pts, _ = log.scan(scan).points()
         p = ExtractionParams(
             cluster_gap=cluster_gap,
@@ -176,29 +179,46 @@ def extraction_explorer(log: Log, k: int):
         fig, ax = plt.subplots(figsize=FIGSIZE)
         plotting.plot_clusters(pts, cluster_scan(pts, cluster_gap), ax=ax)
         plotting.plot_lines(found, ax=ax)
+        for i, line in enumerate(found, 1):
+            ax.annotate(
+                f"l{i} ({line.n})",
+                line.midpoint,
+                xytext=(4, -12),
+                textcoords="offset points",
+                fontsize=8,
+                color="0.15",
+            )
+        ax.plot(0, 0, "k^", ms=9)
         _axes_labels(ax)
-        ax.set_title(f"scan {scan}: {len(found)} lines")
+        ax.set_title(
+            f"scan {scan}: {len(found)} lines with ≥ {min_points} points (in parentheses)\n"
+            f"window ±{window_deg:g}°, inliers within {100 * inlier_dist:g} cm, "
+            f"gap {cluster_gap:.2f} m, densify {densify_step:.2f} m",
+            fontsize=10,
+        )
         return fig
 
     return Explorer(
         draw,
         {
-            "scan": slider(int(k), 0, len(log) - 1, 1, "scan"),
-            "cluster_gap": slider(d.cluster_gap, 0.05, 1.5, 0.05, "cluster gap [m]"),
-            "window_deg": slider(d.window_deg, 0.5, 20.0, 0.5, "Hough window ± [°]"),
+            "min_points": slider(int(d.min_points), 2, 64, 1, "support threshold [points]"),
+            "window_deg": slider(d.window_deg, 0.0, 20.0, 0.5, "Hough window ± [°]"),
             "inlier_dist": slider(
                 d.inlier_dist, 0.005, 0.15, 0.005, "inlier distance [m]", readout_format=".3f"
             ),
-            "min_points": slider(int(d.min_points), 2, 40, 1, "support threshold [points]"),
+            "cluster_gap": slider(d.cluster_gap, 0.05, 1.5, 0.05, "cluster gap [m]"),
             "densify_step": slider(d.densify_step, 0.0, 0.3, 0.01, "densify step [m]"),
+            "scan": slider(int(k), 0, len(log) - 1, 1, "scan"),
         },
         "Fast Hough extraction: the thresholds",
     )
 
 
 def similarity_explorer():
-    """Notebook 04: the four similarity conditions of a reference line and a new line that
-    the sliders turn, shift and slide, under thresholds the sliders set."""
+    """Notebook 04: the four similarity conditions of a reference line (Fig. 7's) and a new
+    line that the sliders turn about its middle (the first slider: each 1° step changes the
+    angle in the title), move across and slide along, under thresholds the sliders set; the
+    robot stands at :data:`~fhslam.figures.scenes.SIMILARITY_POSE`, below the reference."""
     from fhslam.figures.scenes import SIMILARITY_POSE, similarity_examples
     from fhslam.geometry import compose
     from fhslam.lines import transform_lines
@@ -216,19 +236,34 @@ def similarity_explorer():
         (new,) = transform_lines([ref], moved)
         params = MatchParams(max_angle_deg=max_angle_deg, max_distance=max_distance)
         s = similarity(ref, new, params, pose=SIMILARITY_POSE)
-        fig, ax = plt.subplots(figsize=FIGSIZE)
+        fig, ax = plt.subplots(figsize=(8.5, 3.4), layout="constrained")
+        # (c)'s band about the (horizontal) reference: the new line's endpoints must lie in
+        # it, and the reference's endpoints as close to the new line
+        ax.fill_between(
+            [ref.sp[0], ref.ep[0]],
+            mid[1] - max_distance,
+            mid[1] + max_distance,
+            color="0.9",
+            zorder=1,
+            label=f"(c) band ±{max_distance:.2f} m",
+        )
         plotting.plot_lines([ref], ax=ax, color="0.5", linewidth=5, label="reference")
         color = "tab:green" if s.similar else "tab:red"
         plotting.plot_lines([new], ax=ax, color=color, linewidth=2, label="new line")
-        plotting.plot_robot(SIMILARITY_POSE, ax=ax, size=0.2)
+        plotting.plot_robot(SIMILARITY_POSE, ax=ax, size=0.2, label="robot")
+        ax.set(xlim=(-4.8, 4.8), ylim=(0.4, 3.6))
+        ax.set_aspect("equal", adjustable="box")
         ax.set_xlabel("x [m]")
         ax.set_ylabel("y [m]")
-        ax.legend(loc="lower right")
+        ax.legend(loc="center left", bbox_to_anchor=(1.01, 0.5), fontsize=8)
         ok = {True: "✓", False: "✗"}
         ax.set_title(
-            f"(a) direction {ok[s.same_direction]}  (b) angle {ok[s.angle_ok]}  "
-            f"(c) distance {ok[s.distance_ok]}  (d) overlap {ok[s.overlap_ok]}: "
-            + ("similar" if s.similar else "not similar")
+            f"(a) same side {ok[s.same_direction]}   "
+            f"(b) angle {s.angle_deg:.1f}° {ok[s.angle_ok]}   "
+            f"(c) distance {s.distance:.2f} m {ok[s.distance_ok]}   "
+            f"(d) overlap {s.overlap:+.2f} m {ok[s.overlap_ok]}\n→ "
+            + ("similar" if s.similar else "not similar"),
+            fontsize=10,
         )
         return fig
 
@@ -237,8 +272,8 @@ def similarity_explorer():
         draw,
         {
             "turn_deg": slider(0.0, -30.0, 30.0, 1.0, "turn the new line [°]"),
-            "offset": slider(0.0, -1.0, 1.0, 0.02, "move it across [m]"),
-            "slide": slider(0.0, -4.0, 4.0, 0.1, "slide it along [m]"),
+            "offset": slider(0.0, -1.5, 1.0, 0.02, "move it across [m]"),
+            "slide": slider(0.0, -3.5, 3.5, 0.1, "slide it along [m]"),
             "max_angle_deg": slider(d.max_angle_deg, 0.5, 30.0, 0.5, "threshold (b): angle [°]"),
             "max_distance": slider(d.max_distance, 0.01, 1.0, 0.01, "threshold (c): distance [m]"),
         },
@@ -248,7 +283,14 @@ def similarity_explorer():
 
 def calibration_explorer(log: Log, k: int):
     """Notebook 05: self-calibration of a pose that the sliders put wrong, on the lines of
-    scan ``k`` placed with the true pose as the reference map."""
+    scan ``k`` placed with the true pose as the reference map.
+
+    The sliders set the odometry's error in the robot's frame (forward, left, heading), the
+    similarity thresholds (c) and (b) that decide which new lines are matched, and the
+    Gauss-Newton rounds. Left: the new lines at the predicted pose, matched ones solid,
+    unmatched dashed; right: at the calibrated pose. The dashed triangle is the true pose."""
+    from matplotlib.lines import Line2D
+
     from fhslam.calibration import calibrate_pose
     from fhslam.geometry import compose, wrap_angle
     from fhslam.lines import transform_lines
@@ -258,41 +300,72 @@ def calibration_explorer(log: Log, k: int):
     points, _ = log.scan(k).points()
     observed = extract_lines(points)
     references = transform_lines(observed, truth)
+    legend = [
+        Line2D([], [], color="0.6", lw=5, label="reference lines"),
+        Line2D([], [], color="tab:red", lw=2.5, label="new lines, matched"),
+        Line2D([], [], color="tab:orange", lw=2.5, ls="--", label="new lines, not matched"),
+        Line2D([], [], color="k", marker="^", ms=9, mfc=plotting.ROBOT_COLOR, ls="", label="pose"),
+        Line2D([], [], color="k", marker="^", ms=9, mfc="none", ls="", label="true pose"),
+    ]
 
-    def draw(dx_cm, dy_cm, dtheta_deg, gate, iterations) -> Figure:
+    def segments(ax, lines, **kw) -> None:
+        """All ``lines`` as one artist (a redraw well under a second): NaN between them."""
+        if lines:
+            xy = np.array([[q.sp, q.ep, (np.nan, np.nan)] for q in lines]).reshape(-1, 2)
+            ax.plot(*xy.T, solid_capstyle="round", **kw)
+
+    def draw(dx_cm, dy_cm, dtheta_deg, gate, max_angle_deg, iterations) -> Figure:
         predicted = compose(truth, (dx_cm / 100, dy_cm / 100, np.radians(dtheta_deg)))
-        match = match_lines(
-            transform_lines(observed, predicted),
-            references,
-            MatchParams(max_distance=gate),
-            pose=predicted,
-        )
+        params = MatchParams(max_distance=gate, max_angle_deg=max_angle_deg)
+        match = match_lines(transform_lines(observed, predicted), references, params, predicted)
         pairs = [(i, int(j)) for i, j in enumerate(match) if j >= 0]
-        pose = (
-            calibrate_pose(observed, references, pairs, predicted, iterations=iterations).pose
-            if pairs
-            else predicted
-        )
-        fig, axes = plt.subplots(1, 2, figsize=(10, 4.5))
-        for ax, p, name in ((axes[0], predicted, "predicted"), (axes[1], pose, "calibrated")):
-            plotting.plot_lines(references, ax=ax, color="0.6", linewidth=5)
-            plotting.plot_lines(transform_lines(observed, p), ax=ax, color="tab:red")
+        cal = calibrate_pose(observed, references, pairs, predicted, iterations=iterations)
+        fig, axes = plt.subplots(1, 2, figsize=(10, 5.2))
+        ends = [np.array([[r.sp, r.ep] for r in references]).reshape(-1, 2)]
+        for ax, p, name in ((axes[0], predicted, "predicted"), (axes[1], cal.pose, "calibrated")):
+            placed = transform_lines(observed, p)
+            ends.append(np.array([[q.sp, q.ep] for q in placed]).reshape(-1, 2))
+            segments(ax, references, color="0.6", lw=5)
+            matched = [placed[i] for i, _ in pairs]
+            unmatched = [q for i, q in enumerate(placed) if match[i] < 0]
+            segments(ax, matched, color="tab:red", lw=2.5, marker="o", ms=4)
+            segments(ax, unmatched, color="tab:orange", lw=2.5, ls="--", marker="o", ms=4)
             plotting.plot_robot(p, ax=ax)
+            plotting.plot_robot(truth, ax=ax, facecolor="none", linestyle="--", zorder=7)
             err = 100 * np.hypot(*(np.asarray(p[:2]) - truth[:2]))
-            dth = np.degrees(wrap_angle(p[2] - truth[2]))
+            dth = round(float(np.degrees(wrap_angle(p[2] - truth[2]))), 2) + 0.0  # no "-0.00"
             ax.set_title(f"{name}: {err:.1f} cm, {dth:+.2f}° off")
-            ax.set_xlabel("x [m]")
-        axes[0].set_ylabel("y [m]")
-        fig.suptitle(f"{len(pairs)} of {len(observed)} lines matched (gate {gate:.2f} m)")
+            ax.set_xlabel("x [m] (world)")
+        lo, hi = np.vstack(ends).min(axis=0) - 0.5, np.vstack(ends).max(axis=0) + 0.5
+        for ax in axes:  # the same window on both sides, to see what moved
+            ax.set_aspect("equal", adjustable="box")
+            ax.set_xlim(lo[0], hi[0])
+            ax.set_ylim(lo[1], hi[1])
+        axes[0].set_ylabel("y [m] (world)")
+        fig.legend(handles=legend, loc="lower center", ncol=5, fontsize=9, frameon=False)
+        fig.subplots_adjust(left=0.07, right=0.98, bottom=0.2, top=0.8, wspace=0.2)
+        fixed = {
+            (True, True): "the position in both directions",
+            (False, True): "the position in one direction only (the other is kept)",
+        }.get(cal.constrained, "no position")
+        fig.suptitle(
+            f"{len(pairs)} of {len(observed)} lines matched (gate (c) {gate:.2f} m, "
+            f"(b) {max_angle_deg:g}°)\nthey fix the heading and {fixed}"
+            if pairs
+            else f"no line matched (gate (c) {gate:.2f} m, (b) {max_angle_deg:g}°)\n"
+            "the predicted pose is kept"
+        )
         return fig
 
+    d = MatchParams()
     return Explorer(
         draw,
         {
-            "dx_cm": slider(20.0, -50.0, 50.0, 1.0, "odometry error x [cm]"),
-            "dy_cm": slider(-15.0, -50.0, 50.0, 1.0, "odometry error y [cm]"),
-            "dtheta_deg": slider(3.0, -10.0, 10.0, 0.5, "odometry error θ [°]"),
-            "gate": slider(0.6, 0.05, 1.5, 0.05, "matching gate (c) [m]"),
+            "dx_cm": slider(20.0, -50.0, 50.0, 1.0, "odometry error forward (robot x) [cm]"),
+            "dy_cm": slider(-15.0, -50.0, 50.0, 1.0, "odometry error left (robot y) [cm]"),
+            "dtheta_deg": slider(3.0, -10.0, 10.0, 0.5, "odometry error heading [°]"),
+            "gate": slider(0.6, 0.05, 1.5, 0.05, "threshold (c): distance gate [m]"),
+            "max_angle_deg": slider(d.max_angle_deg, 1.0, 20.0, 0.5, "threshold (b): angle [°]"),
             "iterations": slider(3, 0, 6, 1, "Gauss-Newton iterations"),
         },
         "Self-calibration: put the pose wrong, see it corrected",

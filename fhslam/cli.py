@@ -230,12 +230,20 @@ def _profiling(enabled: bool) -> Iterator[None]:
 
 def _slam(args: argparse.Namespace) -> None:
     import fhslam.datasets  # noqa: F401  (imported before --profile starts: not what it shows)
-    from fhslam.errors import InputWarning
-    from fhslam.io import write_map, write_trajectory
+    from fhslam.errors import InputError, InputWarning
+    from fhslam.io import write_graph, write_map, write_trajectory
     from fhslam.io.files import check_outputs
-    from fhslam.pipeline import run_slam
+    from fhslam.pipeline import keyframe_graph, make_backend, run_backend, run_slam
 
-    check_outputs({"--trajectory": args.trajectory, "--map": args.map}, {"the input log": args.log})
+    if args.graph is not None and args.method != "graph":
+        raise InputError(
+            f"--graph: only with --method graph; the {args.method} method keeps no keyframe "
+            "graph (nothing was written)"
+        )
+    check_outputs(
+        {"--trajectory": args.trajectory, "--map": args.map, "--graph": args.graph},
+        {"the input log": args.log},
+    )
     with _profiling(args.profile):
         log = _load(args)
         if len(log) == 1:
@@ -245,7 +253,14 @@ def _slam(args: argparse.Namespace) -> None:
                 InputWarning,
                 stacklevel=1,
             )
-        result = run_slam(log, args.method, progress=not args.quiet and len(log) > 200)
+        progress = not args.quiet and len(log) > 200
+        graph = None
+        if args.graph is None:
+            result = run_slam(log, args.method, progress=progress)
+        else:
+            backend = make_backend(args.method)
+            result = run_backend(backend, log, progress, desc=f"{args.method} {log.name}")
+            graph = keyframe_graph(backend, log)
         # Everything is computed before anything is written: bad input leaves no half files.
         write_trajectory(
             args.trajectory,
@@ -253,10 +268,17 @@ def _slam(args: argparse.Namespace) -> None:
             result.poses,
             header=f"fhslam slam --method {args.method} {args.log}: timestamp x y theta",
         )
+        wrote = [f"{len(result.poses)} poses to {args.trajectory}"]
         if args.map is not None:
             write_map(args.map, result.map)
-        extra = f" and {len(result.map)} map lines to {args.map}" if args.map else ""
-        print(f"wrote {len(result.poses)} poses to {args.trajectory}{extra}")
+            wrote.append(f"{len(result.map)} map lines to {args.map}")
+        if graph is not None:
+            write_graph(args.graph, graph)
+            wrote.append(
+                f"{len(graph)} keyframes and {len(graph.active)} loop closures "
+                f"({graph.n_active} active) to {args.graph}"
+            )
+        print("wrote " + ", ".join(wrote[:-1]) + (" and " if len(wrote) > 1 else "") + wrote[-1])
 
 
 def _bench(args: argparse.Namespace) -> None:
@@ -381,6 +403,13 @@ def build_parser() -> argparse.ArgumentParser:
     )
     p.add_argument("--trajectory", required=True, type=Path, help="output: timestamp x y theta")
     p.add_argument("--map", type=Path, help="output map JSON (reference lines)")
+    p.add_argument(
+        "--graph",
+        type=Path,
+        help="output keyframe-graph JSON (--method graph only): each keyframe's timestamp and "
+        "world-frame pose, each accepted loop closure's keyframes, score and whether it is "
+        "still active",
+    )
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.add_argument("--profile", action="store_true", help=PROFILE_HELP)
     p.set_defaults(run=_slam)

@@ -22,7 +22,7 @@ from tqdm.auto import tqdm
 
 from fhslam.baselines import hough_opencv_pointset
 from fhslam.geometry import compose, inverse
-from fhslam.io import Log
+from fhslam.io import KeyframeGraph, Log
 from fhslam.lines import Line
 from fhslam.slam import (
     Backend,
@@ -36,7 +36,15 @@ from fhslam.slam import (
     StepResult,
 )
 
-__all__ = ["METHODS", "Method", "SlamResult", "make_backend", "run_backend", "run_slam"]
+__all__ = [
+    "METHODS",
+    "Method",
+    "SlamResult",
+    "keyframe_graph",
+    "make_backend",
+    "run_backend",
+    "run_slam",
+]
 
 
 @dataclass
@@ -177,3 +185,25 @@ def run_slam(
     """
     backend = make_backend(method, params)
     return run_backend(backend, log, progress, desc=f"{method} {log.name}".strip())
+
+
+def keyframe_graph(backend: GraphFastHoughSLAM, log: Log) -> KeyframeGraph:
+    """The keyframes and loop closures of a graph back end that :func:`run_backend` drove
+    over ``log``: each keyframe's timestamp and optimised robot pose in the world frame (the
+    pose the trajectory gives the scan that started it), each accepted loop closure and
+    whether it is still active (what ``fhslam slam --graph`` writes)."""
+    steps = backend.keyframe_steps
+    if len(steps) != len(backend.graph) or (len(steps) and steps[-1] >= len(log)):
+        raise ValueError("the back end was not run over this log (keyframes do not match)")
+    poses = compose(backend.origin, backend.graph.poses).reshape(-1, 3) if len(steps) else []
+    offset = log.laser_offset
+    if len(steps) and offset is not None and np.any(offset != 0):  # it ran on laser poses
+        poses = compose(poses, inverse(offset)).reshape(-1, 3)
+    loops = backend.loops
+    return KeyframeGraph(
+        timestamps=np.asarray(log.timestamps, dtype=float)[steps],
+        poses=np.asarray(poses, dtype=float).reshape(-1, 3),
+        loops=np.array([(lc.old, lc.new) for lc in loops], dtype=np.intp).reshape(-1, 2),
+        active=np.array([backend.graph.is_active(lc.edge) for lc in loops], dtype=bool),
+        scores=np.array([lc.score for lc in loops], dtype=float),
+    )

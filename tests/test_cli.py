@@ -367,6 +367,49 @@ def test_slam_then_evaluate_beats_odometry(tmp_path):
     assert scores["slam"]["map_error"] < 0.05 and scores["slam"]["map_coverage"] > 0.8
 
 
+def test_slam_graph_writes_the_keyframes_and_loop_closures(tmp_path, capsys):
+    """``--graph`` (graph method): every keyframe is a scan of the trajectory, at its pose;
+    the closures of three laps are there; the trajectory is the one without ``--graph``."""
+    from fhslam.io import read_graph
+
+    log, _ = _simulate_drifting(tmp_path, "random:105")
+    capsys.readouterr()
+    traj, graph = tmp_path / "t.txt", tmp_path / "g.json"
+    argv = ["slam", str(log), "--trajectory", str(traj), "--graph", str(graph), "--quiet"]
+    assert main(argv) == 0
+    out = capsys.readouterr().out
+    t, poses = read_trajectory(traj)
+    g = read_graph(graph)
+    assert out == (
+        f"wrote {len(t)} poses to {traj} and {len(g)} keyframes and {len(g.active)} loop "
+        f"closures ({g.n_active} active) to {graph}\n"
+    )
+    assert 50 < len(g) < len(t) and g.n_active > 10  # three laps: closures on laps 2 and 3
+    assert g.timestamps[0] == t[0] and np.all(np.diff(g.timestamps) > 0)
+    k = np.searchsorted(t, g.timestamps)
+    np.testing.assert_array_equal(t[k], g.timestamps)
+    np.testing.assert_allclose(g.poses, poses[k], rtol=0, atol=1e-9)
+    assert np.all(g.loops[:, 0] < g.loops[:, 1]) and np.all(g.scores > 0)
+    assert main(["slam", str(log), "--trajectory", str(tmp_path / "u.txt"), "--quiet"]) == 0
+    np.testing.assert_array_equal(read_trajectory(tmp_path / "u.txt")[1], poses)
+
+
+@pytest.mark.parametrize("method", ["fht", "odometry"])
+def test_slam_graph_is_refused_for_a_method_without_one(short_clf, tmp_path, method):
+    traj, graph = tmp_path / "t.txt", tmp_path / "g.json"
+    r = run("slam", str(short_clf), "--method", method, "--trajectory", str(traj), "--graph",
+            str(graph))  # fmt: skip
+    assert r.returncode == 2 and r.stdout == ""
+    assert r.stderr == (
+        f"fhslam: error: --graph: only with --method graph; the {method} method keeps no "
+        "keyframe graph (nothing was written)\n"
+    )
+    assert list(tmp_path.iterdir()) == []
+    r = run("slam", str(short_clf), "--trajectory", str(traj), "--graph", str(traj))
+    assert r.returncode == 2 and "--graph" in r.stderr and "also given as --trajectory" in r.stderr
+    assert list(tmp_path.iterdir()) == []
+
+
 def test_slam_bad_log_leaves_no_output(tmp_path):
     bad = tmp_path / "bad.clf"
     bad.write_text("FLASER 3 1.0 2.0 3.0 0 0 0 0 0 0 1.0 host 1.0\nFLASER 3 1.0 nan?\n")

@@ -1,5 +1,5 @@
 """Reading and writing logs, trajectories and maps: CARMEN logs, trajectory files, map JSON,
-benchmark relations files. Every reader reports bad input as a
+keyframe-graph JSON, benchmark relations files. Every reader reports bad input as a
 :class:`fhslam.errors.InputError` naming the file (and line); every writer writes atomically
 (:mod:`fhslam.io.files`). Input that is readable but implausible is read as documented with
 a warning, a subclass of :class:`fhslam.errors.InputWarning` (``CarmenWarning``,
@@ -12,6 +12,7 @@ from fhslam.io.carmen import (
     read_carmen,
     write_carmen,
 )
+from fhslam.io.graphfile import GraphFormatError, KeyframeGraph, read_graph, write_graph
 from fhslam.io.log import Log, effective_max_range, no_return_reading
 from fhslam.io.mapfile import MapFormatError, lines_from_segments, read_map, write_map
 from fhslam.io.relations import RelationsFormatError, read_relations
@@ -28,6 +29,8 @@ __all__ = [
     "BagWarning",
     "CarmenFormatError",
     "CarmenWarning",
+    "GraphFormatError",
+    "KeyframeGraph",
     "Log",
     "MapFormatError",
     "RelationsFormatError",
@@ -40,10 +43,12 @@ __all__ = [
     "no_return_reading",
     "read_bag",
     "read_carmen",
+    "read_graph",
     "read_map",
     "read_relations",
     "read_trajectory",
     "write_carmen",
+    "write_graph",
     "write_map",
     "write_trajectory",
 ]

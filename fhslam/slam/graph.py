@@ -279,6 +279,13 @@ class GraphFastHoughSLAM:
         self._scan_kf: list[int] = []
         self._scan_rel: list[NDArray[np.float64]] = []
 
+    @property
+    def keyframe_steps(self) -> NDArray[np.intp]:
+        """For each keyframe of :attr:`graph`, the index of the step (the scan) that started
+        it, shape (K,)."""
+        kf = np.asarray(self._scan_kf, dtype=np.intp)
+        return np.flatnonzero(np.diff(kf, prepend=-1))
+
     # -- the per-scan step -----------------------------------------------------------------
     def step(self, scan: Scan | None, odometry: ArrayLike) -> StepResult:
         """Track one scan, start a keyframe when due, attach the scan to it; returns the

@@ -27,6 +27,7 @@ from fhslam.io.files import atomic_output
 
 __all__ = [
     "FORMATS",
+    "RESULTS",
     "NotebookRun",
     "notebooks_in",
     "pair",
@@ -40,6 +41,10 @@ __all__ = [
 #: percent-format ``.py``; the ``.py``'s header leaves out jupytext's version, so that another
 #: jupytext release does not change every file.
 FORMATS = "ipynb,py:percent"
+
+#: The folder beside the notebooks holding the results they load (``fhslam sweep --out``,
+#: ``fhslam slam``), too slow to compute in a notebook.
+RESULTS = "results"
 _JUPYTEXT = {
     "formats": FORMATS,
     "notebook_metadata_filter": "-jupytext.text_representation.jupytext_version",
@@ -173,7 +178,10 @@ def _is_solution(cell: dict) -> bool:
 def student_copy(source: str | PathLike[str], out: str | PathLike[str]) -> list[tuple[Path, int]]:
     """Write every notebook of folder ``source`` to folder ``out`` without its solution cells
     (cells tagged ``solution``) and without outputs; returns ``(path, solutions removed)`` per
-    notebook. ``out`` must not be ``source``. The copies are not paired with a ``.py``."""
+    notebook. ``out`` must not be ``source``. The copies are not paired with a ``.py``; the
+    results the notebooks load (folder ``results``) are copied with them."""
+    import shutil
+
     import nbformat
 
     src, dst = Path(source), Path(out)
@@ -194,4 +202,6 @@ def student_copy(source: str | PathLike[str], out: str | PathLike[str]) -> list[
         with atomic_output(dst / path.name) as f:
             nbformat.write(nb, f)
         written.append((dst / path.name, removed))
+    if (src / RESULTS).is_dir():
+        shutil.copytree(src / RESULTS, dst / RESULTS, dirs_exist_ok=True)
     return written

@@ -87,6 +87,7 @@ def lab(tmp_path_factory):
     work.mkdir()
     for path in NOTEBOOKS:
         shutil.copy(path, work / path.name)
+    shutil.copytree(NOTEBOOKS[0].parent / "results", work / "results")  # what they load
     for name, value in SETTINGS.items():
         target = settings / name
         target.parent.mkdir(parents=True, exist_ok=True)

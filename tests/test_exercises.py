@@ -123,6 +123,9 @@ def test_student_copy_removes_every_solution_and_output(tmp_path, capsys):
         assert [c.source for c in copy.cells] == [
             c.source for c in original.cells if "solution" not in tags(c)
         ]
+    results = NOTEBOOKS[0].parent / "results"  # what the notebooks load comes along
+    copied = sorted(p.relative_to(out / "results") for p in (out / "results").rglob("*"))
+    assert copied == sorted(p.relative_to(results) for p in results.rglob("*"))
 
 
 def test_student_copy_refuses_bad_folders(tmp_path, capsys):

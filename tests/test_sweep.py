@@ -20,7 +20,16 @@ COMMITTED = Path(__file__).parents[1] / "notebooks" / "results" / "sweep_paper.c
 
 @pytest.fixture(scope="module")
 def runs():
-    return one_run("paper", "low", 0, ("fht", "odometry"))
+    every = one_run("paper", "low", 0, ("fht", "graph", "classical", "ekf", "odometry"))
+    return every + one_run("paper", "medium", 0, ("graph",))
+
+
+#: How far a run now may be from the committed file's, in ATE (m): the line methods'
+#: results hold to far below a millimetre on any machine; the graph method's correlative
+#: search picks among near-equal cells, so its ATE on the paper world moves by up to about a
+#: centimetre under last-bit changes (README, "robustness"). A stale file is off by more: the
+#: graph rows of a file made before the tracker's last changes were 2-4 cm off.
+ATE_TOLERANCE = {"graph": 0.015}
 
 
 def test_a_sweep_file_reads_back_exactly(runs, tmp_path):
@@ -31,21 +40,24 @@ def test_a_sweep_file_reads_back_exactly(runs, tmp_path):
             x, y = getattr(a, name), getattr(b, name)
             assert x == y or (np.isnan(x) and np.isnan(y)), name  # odometry: no map, NaN
     table = format_summary(back)
-    assert table.splitlines()[0] == "2 runs: 1 seeds x 1 levels x 2 methods"
+    assert table.splitlines()[0] == "6 runs: 1 seeds x 2 levels x 5 methods"
     assert "FH-SLAM (paper)" in table and "odometry" in table
 
 
 def test_the_committed_sweep_is_what_this_code_computes(runs):
-    """The file notebook 07 shows came from ``fhslam sweep --seeds 20``: its run of seed 0 at
-    the low level agrees with a run now (ATE to 0.5 mm; times are the machine's)."""
+    """The file notebook 07 shows came from ``fhslam sweep --seeds 20``: its runs of seed 0
+    at the low level, every method, and the graph method's at the medium level agree with a
+    run now (ATE to 0.5 mm, the graph method's to 1.5 cm; times are the machine's)."""
     committed = load_sweep(COMMITTED)
     assert len(committed) == 20 * 3 * 5
     assert {(r.seed, r.level) for r in committed} == {
         (s, lv) for s in range(20) for lv in ("low", "medium", "high")
     }
     for r in runs:
-        c = next(x for x in committed if (x.method, x.level, x.seed) == (r.method, "low", 0))
-        assert c.ate_rmse == pytest.approx(r.ate_rmse, abs=5e-4), r.method
+        c = next(x for x in committed if (x.method, x.level, x.seed) == (r.method, r.level, 0))
+        assert c.ate_rmse == pytest.approx(r.ate_rmse, abs=ATE_TOLERANCE.get(r.method, 5e-4)), (
+            r.method
+        )
         assert c.odometry_ate_rmse == pytest.approx(r.odometry_ate_rmse, abs=1e-9)
         assert c.n_map_lines == pytest.approx(r.n_map_lines, abs=2)
 

@@ -283,3 +283,54 @@ def test_association_of_all_lines_at_once_matches_the_landmark_by_landmark_defin
             assert d2 == pytest.approx(min(d), rel=1e-9)
             checked += 1
     assert checked >= 50
+
+
+def staggered_corridor(pairs: int = 24):
+    """A straight corridor lined with ``pairs`` short tilted walls on each side, each a line
+    of its own: the EKF's map grows to 41 landmarks (an 85 x 85 covariance) in 152 scans."""
+    from fhslam.sim import World
+
+    walls = []
+    for side in (1, -1):
+        for i in range(pairs):
+            x0 = 1.3 * i + (0.6 if side < 0 else 0.0)
+            off, tilt = 1.6 + 0.25 * ((3 * i) % 4), 0.12 * ((5 * i) % 7 - 3)
+            walls.append([x0, side * off, x0 + 1.0, side * (off + tilt)])
+    return World("staggered", np.array(walls), np.array([[0.5, 0.0], [1.3 * pairs - 0.5, 0.0]]))
+
+
+def test_the_trajectory_does_not_depend_on_the_blas_thread_count():
+    """Issue 13: filterpy's dense covariance products are split over OpenBLAS threads once the
+    covariance is large enough (above 64 x 64), which changed the trajectory's last bits with
+    the thread count (so with the machine's core count) and made a run 10x slower on busy
+    cores. The filter now runs on one BLAS thread: bit-identical at 1 and 2 threads, the
+    caller's setting untouched after. Measured without the limit on this log: the poses
+    differ from scan 131 on (by 6e-14 m); on MIT CSAIL from scan 186 on (by 8e-12 m)."""
+    from threadpoolctl import ThreadpoolController, threadpool_limits
+
+    from fhslam.pipeline import run_backend
+    from fhslam.sim import MotionParams, simulate
+
+    log = simulate(staggered_corridor(), seed=0, motion=MotionParams(speed=1.0))
+    blas = ThreadpoolController().select(user_api="blas")
+    assert blas.lib_controllers, "no BLAS library found to limit"
+
+    seen: set[int] = set()  # the BLAS threads while the filter works
+
+    class Recording(EKFLineSLAM):
+        def _associate(self, lines, covs):
+            seen.update(lib["num_threads"] for lib in blas.info())
+            return super()._associate(lines, covs)
+
+    poses = {}
+    for threads in (1, 2):
+        seen.clear()
+        with threadpool_limits(threads, "blas"):
+            before = [lib["num_threads"] for lib in blas.info()]
+            slam = Recording()
+            poses[threads] = run_backend(slam, log).poses
+            after = [lib["num_threads"] for lib in blas.info()]
+        assert before == after == [threads] * len(before)  # the limit is lifted after the run
+        assert seen == {1}
+    assert slam.n_landmarks >= 35  # a covariance of at least 73 x 73: OpenBLAS threads it
+    np.testing.assert_array_equal(poses[1], poses[2])

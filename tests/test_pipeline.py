@@ -158,3 +158,23 @@ def test_reference_map_nearby_uses_the_segments():
     assert m.nearby((1.0, 0.5), reach=1.0).tolist() == [0]
     assert m.nearby((6.0, 0.0), reach=4.5).tolist() == [0, 1]
     assert m.nearby((6.0, 0.0), reach=1.0).tolist() == []
+
+
+@pytest.mark.parametrize("method", list(METHODS))
+def test_no_method_depends_on_the_blas_thread_count(method):
+    """Issue 13: every method gives the same bits with BLAS on 1 and on 2 threads (the
+    EKF's dense covariance is the one place threaded BLAS changed them: it limits itself to
+    one thread; fht, graph and classical use no BLAS large enough to be threaded: on MIT
+    CSAIL and Intel, OPENBLAS_NUM_THREADS=1 and =2 gave identical trajectories and the BLAS
+    worker threads no CPU time)."""
+    from test_ekf import staggered_corridor
+    from threadpoolctl import threadpool_limits
+
+    from fhslam.sim import MotionParams, simulate
+
+    log = simulate(staggered_corridor(), seed=0, motion=MotionParams(speed=1.0))
+    poses = []
+    for threads in (1, 2):
+        with threadpool_limits(threads, "blas"):
+            poses.append(run_slam(log, method).poses)
+    np.testing.assert_array_equal(poses[0], poses[1])

@@ -26,16 +26,29 @@ frame, which the filter's inputs (odometry increments, robot-frame lines) determ
 ``r >= 0`` flips a landmark to ``(α + π, −r)`` when an update or its first sighting gives
 ``r < 0``: that map is linear, and ``r``'s rows of the covariance and of the Jacobians flip
 sign with it.
+
+The filter's linear algebra runs on **one BLAS thread**, whatever the environment
+(:meth:`EKFLineSLAM.predict` and :meth:`EKFLineSLAM.update` limit BLAS to one thread while
+they run and restore the caller's setting after, through :mod:`threadpoolctl`). filterpy's
+dense products of the covariance (453 x 453 at :attr:`EKFParams.max_landmarks`) are large
+enough for OpenBLAS to split over threads (from 64 x 64, 31 landmarks, on), and then the
+trajectory's last bits depend on the thread count, so on the machine's core count (MIT
+CSAIL: 8e-12 m from scan 186 on), and a run takes 4-10x longer when the other cores are busy
+(MIT CSAIL on 2 cores at load 3: 22-66 s instead of 5-8 s), the threads waiting on each other.
 """
 
 from __future__ import annotations
 
+import functools
 import warnings
+from collections.abc import Callable
 from dataclasses import dataclass, field
+from typing import ParamSpec, TypeVar
 
 import numpy as np
 from filterpy.kalman import ExtendedKalmanFilter
 from numpy.typing import ArrayLike, NDArray
+from threadpoolctl import ThreadpoolController
 
 from fhslam.extraction import ExtractionParams, extract_lines
 from fhslam.geometry import (
@@ -181,6 +194,29 @@ def line_covariance(points: ArrayLike, line: Line, sigma_floor: float = 0.01) ->
     return np.array([[var_a, tb * var_a], [tb * var_a, s2 / len(p) + tb**2 * var_a]])
 
 
+_P = ParamSpec("_P")
+_T = TypeVar("_T")
+
+
+@functools.cache
+def _blas_pools() -> ThreadpoolController:
+    """The process's BLAS thread pools, found once (finding them takes about 1 ms, a limit
+    with them 0.02 ms); numpy's and scipy's (which filterpy uses) are loaded by then."""
+    return ThreadpoolController()
+
+
+def _one_blas_thread(method: Callable[_P, _T]) -> Callable[_P, _T]:
+    """Run ``method`` with BLAS limited to one thread, the caller's setting restored after
+    (see the module docs: the result must not depend on the machine's core count)."""
+
+    @functools.wraps(method)
+    def limited(*args: _P.args, **kwargs: _P.kwargs) -> _T:
+        with _blas_pools().limit(limits=1, user_api="blas"):
+            return method(*args, **kwargs)
+
+    return limited
+
+
 class _MotionEKF(ExtendedKalmanFilter):
     """filterpy's EKF with the nonlinear motion ``x ⊕ u`` for the robot part of the state."""
 
@@ -243,7 +279,10 @@ class EKFLineSLAM:
         new.P = p
         self.ekf = new
 
+    @_one_blas_thread
     def predict(self, odometry: ArrayLike) -> None:
+        """Predict from the odometry increment since the last call (the first call starts the
+        filter); on one BLAS thread."""
         odo = as_pose(odometry, "odometry")
         if self.ekf is None:
             self._start(self._init_pose if self._init_pose is not None else odo)
@@ -315,8 +354,10 @@ class EKFLineSLAM:
             for j, d in zip(best, best_d2, strict=True)
         ]
 
+    @_one_blas_thread
     def update(self, lines: list[Line], points: NDArray) -> tuple[int, int]:
-        """Associate, update with all matched lines at once, add new landmarks.
+        """Associate, update with all matched lines at once, add new landmarks; on one BLAS
+        thread.
 
         Returns (matched, added)."""
         pr = self.params
@@ -345,7 +386,7 @@ class EKFLineSLAM:
                             f"{pr.max_landmarks} landmarks (its covariance is dense: each more "
                             "slows every step); from here on new lines start no landmark",
                             EKFLandmarkLimitWarning,
-                            stacklevel=2,
+                            stacklevel=3,  # the caller of update, not its BLAS wrapper
                         )
                     continue
                 self._add_landmark(ln, covs[i])

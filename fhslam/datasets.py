@@ -97,13 +97,17 @@ class Dataset:
     statement is wrong; ``None``: the file's statement holds (see :data:`MOUNT_NOTES`)."""
 
     def file(self, kind: str) -> DataFile:
-        """The :class:`DataFile` of ``kind`` (``"log"`` or ``"relations"``)."""
+        """The :class:`DataFile` of ``kind`` (``"log"`` or ``"relations"``); an
+        :class:`~fhslam.errors.InputError` naming the dataset if it has none (a dataset of
+        relations only, such as mit-killian, has no log to read)."""
         if kind not in KINDS:
             raise ValueError(f"kind must be one of {KINDS}, not {kind!r}")
         f = self.log if kind == "log" else self.relations
         if f is None:
-            raise ValueError(
-                f"dataset {self.name!r} has no {kind} file (only its relations are available)"
+            raise InputError(
+                f"dataset {self.name!r} has only relations ({self.relations.name}), no laser "
+                f"log to read; they evaluate a trajectory: fhslam evaluate TRAJECTORY "
+                f"--relations {self.name}"
             )
         return f
 
@@ -274,8 +278,9 @@ def find_dataset(
     is downloaded unless ``download=True``.
 
     Raises :class:`DatasetNotFoundError` (a :class:`~fhslam.errors.MissingInputError`) listing
-    every place looked at, :class:`~fhslam.errors.InputError` for an unknown name and for a
-    local copy whose size is not the recorded one, ``ValueError`` for an unknown kind.
+    every place looked at, :class:`~fhslam.errors.InputError` for an unknown name, for a
+    dataset without a file of ``kind`` (mit-killian has no log) and for a local copy whose
+    size is not the recorded one, ``ValueError`` for an unknown kind.
     """
     if kind not in KINDS:
         raise ValueError(f"kind must be one of {KINDS}, not {kind!r}")

@@ -215,7 +215,7 @@ def log_summary(log: Log, n_sample: int = 200) -> LogSummary:
         duration=float(log.timestamps[-1] - log.timestamps[0]) if len(log) else 0.0,
         odometry_path=path,
         max_range=float(log.max_range),
-        no_return=no_return_reading(log.ranges),
+        no_return=no_return_reading(log.ranges, stated=log.stated_max_range),
         n_sampled=len(n_lines),
         median_lines=float(np.median(n_lines)) if n_lines else float("nan"),
     )

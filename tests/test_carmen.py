@@ -662,8 +662,15 @@ def _flaser(t: float, x: float) -> str:
             r"t\.clf:3: the odometry jumps more than 10 m "
             r"from the scan on line 2 \(1e\+06 m\) \(and at 1 more scan\)",
         ),
+        # issue 13: a leap forward was read silently (the odometry's timestamps lie)
+        (
+            [0.0, 0.2, 1e9, 1e9 + 0.2],
+            [0, 0.1, 0.2, 0.3],
+            r"t\.clf:3: time leaps forward more than a day \(86400 s\) from the "
+            r"scan on line 2 \(0\.2 -> 1000000000\.0\); read as it is",
+        ),
     ],
-    ids=["backwards", "repeated", "odometry-jump"],
+    ids=["backwards", "repeated", "odometry-jump", "leap-forward"],
 )
 def test_implausible_sequences_are_read_with_a_warning_naming_the_line(
     tmp_path, times, xs, message
@@ -709,3 +716,80 @@ def test_scans_without_a_return_are_named(tmp_path):
     ) as rec:
         log = read_carmen(path)
     assert len(rec) == 1 and log.max_range == pytest.approx(81.91)
+
+
+def _robotlaser1_head(start="-1.5707963", res="0.7853982", max_range="20.0") -> str:
+    """The robotlaser1() line of 5 beams with its start angle, resolution and maximum range
+    replaced (fields 3, 5 and 6)."""
+    f = robotlaser1([1, 2, 3, 4, 5], None, [1.0, 2.0, 0.5], 1.0).split()
+    f[2], f[4], f[5] = start, res, max_range
+    return " ".join(f)
+
+
+@pytest.mark.parametrize(
+    ("fields", "message"),
+    [
+        ({"max_range": "0"}, "ROBOTLASER1 maximum_range 0 m is no laser's range: it must be a "
+         "positive number of metres"),
+        ({"max_range": "-5"}, "ROBOTLASER1 maximum_range -5 m is no laser's range"),
+        ({"max_range": "1e308"}, "ROBOTLASER1 maximum_range 1e+308 m is no laser's range: it "
+         "must be below 1000 m"),
+        ({"max_range": "nan"}, "non-finite ROBOTLASER1 start_angle/fov/resolution/max_range"),
+        ({"res": "0"}, "ROBOTLASER1 angular_resolution 0 rad: the angle between beams must be "
+         "positive"),
+        ({"res": "-0.0174533"}, "ROBOTLASER1 angular_resolution -0.0174533 rad: the angle"),
+        ({"res": "100"}, "ROBOTLASER1 angular_resolution 100 rad spreads its 5 beams over "
+         "22918.3 degrees, more than a full turn"),
+        ({"res": "1.6"}, "ROBOTLASER1 angular_resolution 1.6 rad spreads its 5 beams over "
+         "366.693 degrees, more than a full turn"),
+        ({"start": "-90"}, "ROBOTLASER1 start_angle -90 is more than a full turn: CARMEN "
+         "states it in radians, not degrees"),
+    ],
+    ids=["max-range-0", "max-range-negative", "max-range-1e308", "max-range-nan", "res-0",
+         "res-negative", "res-100-rad", "res-over-a-turn", "start-in-degrees"],
+)  # fmt: skip
+def test_a_robotlaser1_header_no_laser_states_is_an_error(tmp_path, fields, message):
+    """Issue 13: a maximum_range of 0 or -5 ended in a traceback (Log.max_range must be
+    positive); a resolution of 0, -1° or 100 rad per beam was read silently (the FLASER
+    PARAM lines' "more than 360 degrees" did not cover ROBOTLASER1)."""
+    path = tmp_path / "rl.clf"
+    good = robotlaser1([2, 3, 4, 5, 6], None, [1.5, 2.0, 0.5], 2.0)
+    path.write_text(f"{good}\n{_robotlaser1_head(**fields)}\n")
+    with pytest.raises(CarmenFormatError, match=re.escape(f"rl.clf:2: {message}")):
+        read_carmen(path)
+
+
+def test_a_reading_repeated_far_below_the_stated_range_is_no_code(tmp_path):
+    """Issue 13: a ROBOTLASER1 log stating 20 m whose scans repeat exactly took the 2.0 m
+    ahead for the no-return code and dropped every reading from 2 m on. A code is sought in
+    the upper half of the stated range only; a FLASER log, stating none, keeps the rule of
+    the readings' own scale."""
+    rows = [[2.5, 2.2, 2.0, 2.2, 2.5]] * 30
+    path = tmp_path / "rl.clf"
+    path.write_text(
+        "".join(robotlaser1(r, None, [0.1 * k, 0, 0], float(k)) + "\n" for k, r in enumerate(rows))
+    )
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        log = read_carmen(path)
+    assert log.max_range == 20.0 and log.stated_max_range == 20.0
+    assert len(log.scan(0).points()[0]) == 5
+    assert no_return_reading(log.ranges) == 2.0 and no_return_reading(log.ranges, stated=20) is None
+    coded = [[2.5, 2.2, 19.5, 2.2, 19.5]] * 30  # a code near the stated range: still found
+    path.write_text(
+        "".join(robotlaser1(r, None, [0.1 * k, 0, 0], float(k)) + "\n" for k, r in enumerate(coded))
+    )
+    assert read_carmen(path).max_range == 19.5
+
+
+def test_no_return_reading_with_a_stated_range_keeps_the_five_logs_codes():
+    """The stated range only ever raises the scale the code is sought in: codes at or above
+    half of it (the Freiburg bags: 81.83 and 81.91 m against 80 or 81.9 m stated, ACES 50 m
+    against 50 m) are found as before."""
+    rng = np.random.default_rng(3)
+    r = np.round(rng.uniform(0.3, 30.0, (300, 180)), 2)
+    r[rng.random(r.shape) < 0.10] = 81.91
+    r[rng.random(r.shape) < 0.01] = 81.83
+    for stated in (None, 80.0, 81.9, 100.0, 160.0):
+        assert no_return_reading(r, stated=stated) == 81.83
+    assert no_return_reading(r, stated=170.0) is None  # 81.83 m is far below 170 m

@@ -18,6 +18,7 @@ from fhslam.datasets import (
     is_held_out,
     verify,
 )
+from fhslam.errors import InputError
 
 SHARED = Path(__file__).resolve().parents[2] / "shared" / "data"
 
@@ -113,8 +114,23 @@ def test_unknown_name_lists_known_names():
 def test_bad_kind_and_missing_log():
     with pytest.raises(ValueError, match="kind"):
         find_dataset("intel", kind="map")
-    with pytest.raises(ValueError, match=r"mit-killian.*no log"):
+    with pytest.raises(InputError, match=r"dataset 'mit-killian' has only relations"):
         find_dataset("mit-killian", kind="log")
+
+
+def test_a_dataset_of_relations_only_is_no_log(monkeypatch):
+    """Issue 13: ``fhslam info mit-killian`` (slam, bench --log) ended in a traceback,
+    ``ValueError: dataset 'mit-killian' has no log file``: an InputError now, saying what the
+    dataset has and what it is for (its relations are found as before)."""
+    from fhslam.datasets import load_log
+
+    with pytest.raises(InputError) as e:
+        load_log("mit-killian")
+    assert str(e.value) == (
+        "dataset 'mit-killian' has only relations (mit-killian.relations), no laser log to "
+        "read; they evaluate a trajectory: fhslam evaluate TRAJECTORY --relations mit-killian"
+    )
+    assert DATASETS["mit-killian"].file("relations").name == "mit-killian.relations"
 
 
 def test_explicit_path_wins(fake, monkeypatch):

@@ -18,6 +18,7 @@ also run as a separate process (:func:`test_the_installed_command_on_a_sample_of
 from __future__ import annotations
 
 import json
+import os
 import signal
 import subprocess
 import sys
@@ -26,6 +27,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from fhslam.cli import main
@@ -59,16 +61,54 @@ SCAN_LINES = [i for i, ln in enumerate(BASE) if ln.startswith("FLASER")]
 """Indices (0-based) of BASE's laser lines; the file line is index + 1."""
 
 
+def _base_robotlaser1(n_scans: int = 12) -> list[str]:
+    """A small valid CARMEN log of ``ROBOTLASER1`` lines (a 270° laser of 271 beams, 10 m,
+    which ``FLASER`` cannot describe), as lines. Fields of a line: 2 start_angle, 4
+    angular_resolution, 5 maximum_range, 8 num_readings, 9... the readings, then
+    num_remissions (0), laser pose, robot pose, ..., ipc_timestamp host logger_timestamp."""
+    import tempfile
+
+    from fhslam.io import write_carmen
+    from fhslam.sim import LaserParams, paper_world, simulate
+
+    laser = LaserParams(n_beams=271, fov_deg=270.0, max_range=10.0)
+    with tempfile.TemporaryDirectory() as d:
+        p = Path(d) / "base.clf"
+        write_carmen(simulate(paper_world(), seed=0, max_scans=n_scans, laser=laser), p)
+        return [ln for ln in p.read_text().splitlines() if not ln.startswith("#")]
+
+
+BASE_RL = _base_robotlaser1()
+RL_LINES = [i for i, ln in enumerate(BASE_RL) if ln.startswith("ROBOTLASER1")]
+"""Indices (0-based) of BASE_RL's laser lines; the file line is index + 1."""
+
+
 def _clf(lines: list[str]) -> str:
     return "\n".join(lines) + "\n"
 
 
-def _edit_scan(k: int, edit: Callable[[list[str]], list[str]]) -> tuple[str, int]:
-    """BASE with the k-th laser line's fields edited; and that line's number in the file."""
-    lines = list(BASE)
-    i = SCAN_LINES[k]
+def _edit_scan(
+    k: int, edit: Callable[[list[str]], list[str]], base: list[str] | None = None
+) -> tuple[str, int]:
+    """BASE (or BASE_RL, ``base=BASE_RL``) with the k-th laser line's fields edited; and
+    that line's number in the file."""
+    lines = list(BASE if base is None else base)
+    i = (SCAN_LINES if base is None else RL_LINES)[k]
     lines[i] = " ".join(edit(lines[i].split()))
     return _clf(lines), i + 1
+
+
+def _edit_rl(k: int, edit: Callable[[list[str]], list[str]]) -> tuple[str, int]:
+    """BASE_RL with the k-th ROBOTLASER1 line's fields edited; and that line's number."""
+    return _edit_scan(k, edit, BASE_RL)
+
+
+def _set_field(index: int, value: str) -> Callable[[list[str]], list[str]]:
+    def edit(f: list[str]) -> list[str]:
+        f[index] = value
+        return f
+
+    return edit
 
 
 def _set_reading(k: int, value: str) -> tuple[str, int]:
@@ -79,10 +119,10 @@ def _set_reading(k: int, value: str) -> tuple[str, int]:
     return _edit_scan(k, edit)
 
 
-def _set_times(times: list[float]) -> str:
-    """BASE with the laser lines' three timestamps (ipc, logger) set to ``times``."""
-    lines = list(BASE)
-    for i, t in zip(SCAN_LINES, times, strict=False):
+def _set_times(times: list[float], base: list[str] | None = None) -> str:
+    """BASE (or BASE_RL) with the laser lines' timestamps (ipc, logger) set to ``times``."""
+    lines = list(BASE if base is None else base)
+    for i, t in zip(SCAN_LINES if base is None else RL_LINES, times, strict=False):
         f = lines[i].split()
         f[-3] = f[-1] = repr(t)
         lines[i] = " ".join(f)
@@ -119,6 +159,12 @@ def _all_max_range(scans: slice = slice(None)) -> str:
     return _clf(lines)
 
 
+class _Fifo:
+    """A named pipe in a case's files (nothing ever writes into it: opening it blocks)."""
+
+
+FIFO = _Fifo()
+
 PNG = b"\x89PNG\r\n\x1a\n\x00\x00\x00\rIHDR" + bytes(range(256)) * 4
 BINARY = zlib.compress(bytes(range(256)) * 64)
 
@@ -147,14 +193,15 @@ class Case:
     """A command line run on files written into the case's folder.
 
     ``files`` maps a file name to its content (text or bytes; a name ending in ``/`` is a
-    folder). In ``argv``, ``{d}`` stands for the folder. ``expect`` is ``"error"`` or
-    ``"warn"``; ``names`` must appear in the message (the file and, where there is one, the
-    line; ``{d}`` as above), ``outputs`` are the files the command writes when it succeeds.
+    folder, the content :data:`FIFO` a named pipe). In ``argv``, ``{d}`` stands for the
+    folder. ``expect`` is ``"error"`` or ``"warn"``; ``names`` must appear in the message
+    (the file and, where there is one, the line; ``{d}`` as above), ``outputs`` are the
+    files the command writes when it succeeds.
     """
 
     id: str
     argv: list[str]
-    files: dict[str, str | bytes]
+    files: dict[str, str | bytes | _Fifo]
     expect: str
     names: list[str]
     outputs: tuple[str, ...] = ()
@@ -216,6 +263,13 @@ def _log_cases() -> list[Case]:
         _slam("log.clf", _odometry_jump(5, 1e6), "warn", ["log.clf:"], id="clf-odometry-jump"),
         _slam("log.clf", _set_times([0, 1, 2, 3, 2.5, 4, 5]), "warn", id="clf-time-backwards"),
         _slam("log.clf", _set_times([0, 1, 2, 2, 3, 4, 5]), "warn", id="clf-time-repeated"),
+        _slam(
+            "log.clf",
+            _set_times([0, 1, 2] + [1e9 + k for k in range(9)]),
+            "warn",
+            names=[f"log.clf:{SCAN_LINES[3] + 1}: time leaps forward"],
+            id="clf-time-leap",
+        ),
         _slam("log.clf", _all_max_range(), "warn", id="clf-all-no-return"),
     ]
     # The SLAM methods themselves on what the reader accepts with a warning.
@@ -235,6 +289,62 @@ def _log_cases() -> list[Case]:
     cases.append(
         _slam("log.clf", _wide_scan(100_000), "warn", method=None, id="default-100000-beams")
     )
+    return cases + _robotlaser1_cases()
+
+
+def _robotlaser1_cases() -> list[Case]:
+    """``ROBOTLASER1`` lines: malformed ones, readings no laser gives, and a header that
+    states what no laser has (issue 13: a maximum_range of 0 ended in a traceback, a
+    resolution of 0 or 100 rad was read silently)."""
+    n = int(BASE_RL[RL_LINES[0]].split()[8])
+    cases = []
+    for value, what in [("abc", "not-a-number"), ("nan", "nan"), ("inf", "inf"),
+                        ("-1.5", "negative")]:  # fmt: skip
+        content, line = _edit_rl(3, _set_field(9 + 40, value))
+        expect = "error" if what == "not-a-number" else "warn"
+        cases.append(
+            _slam("log.clf", content, expect, names=[f"log.clf:{line}"], id=f"rl-range-{what}")
+        )
+    edits = {  # of the third laser line
+        "rl-truncated-line": lambda f: f[: len(f) // 2],
+        "rl-beam-count+1": _set_field(8, str(n + 1)),
+        "rl-beam-count-1": _set_field(8, str(n - 1)),
+        "rl-beam-count-float": _set_field(8, f"{n}.5"),
+        "rl-remission-count-5": _set_field(9 + n, "5"),
+        "rl-pose-nan": _set_field(9 + n + 4, "nan"),
+    }
+    for case_id, edit in edits.items():
+        content, line = _edit_rl(2, edit)
+        cases.append(_slam("log.clf", content, names=[f"log.clf:{line}"], id=case_id))
+    headers = {  # of every laser line alike (the first one is named)
+        "rl-header-not-a-number": (3, "wide"),
+        "rl-max-range-0": (5, "0"),
+        "rl-max-range-negative": (5, "-5"),
+        "rl-max-range-nan": (5, "nan"),
+        "rl-max-range-1e308": (5, "1e308"),
+        "rl-resolution-0": (4, "0"),
+        "rl-resolution-negative": (4, "-0.0174533"),
+        "rl-resolution-100-rad": (4, "100"),
+        "rl-start-angle-in-degrees": (2, "-135"),
+    }
+    first = f"log.clf:{RL_LINES[0] + 1}:"
+    for case_id, (index, value) in headers.items():
+        lines = list(BASE_RL)
+        for i in RL_LINES:
+            lines[i] = " ".join(_set_field(index, value)(lines[i].split()))
+        cases.append(_slam("log.clf", _clf(lines), names=[first], id=case_id))
+    whole = _clf(BASE_RL)
+    last = whole.rindex("ROBOTLASER1")
+    cut = whole[: last + (len(whole) - last) // 2]
+    cases += [
+        _slam("log.clf", cut, names=[f"log.clf:{RL_LINES[-1] + 1}"], id="rl-truncated-file"),
+        _slam("log.clf", _set_times([0, 1, 2] + [1e9 + k for k in range(9)], BASE_RL),
+              "warn", names=[f"log.clf:{RL_LINES[3] + 1}: time leaps forward"],
+              id="rl-time-leap"),
+        _slam("log.clf", _set_times([0, 1, 2, 1.5] + [3 + k for k in range(8)], BASE_RL),
+              "warn", names=[f"log.clf:{RL_LINES[3] + 1}: time goes backwards"],
+              id="rl-time-backwards"),
+    ]  # fmt: skip
     return cases
 
 
@@ -249,6 +359,15 @@ def _bag(name: str, **kw) -> bytes:
 
 def _bag_cases() -> list[Case]:
     whole = _bag("g.bag", scans=6)
+    nan, inf = float("nan"), float("inf")
+
+    def readings(value: float) -> Callable:
+        return lambda k, a: np.full(len(a), value)
+
+    def some(value: float) -> Callable:  # the wall, with every other beam at value
+        return lambda k, a: np.where(np.arange(len(a)) % 2 == 0, 2.0, value)
+
+    scan0, odom = ["t.bag", "scan 0 of topic '/scan'"], ["t.bag", "odometry message"]
     return [
         _slam("t.bag", whole[: len(whole) // 2], id="bag-truncated"),
         _slam("t.bag", whole[:13], id="bag-magic-only"),
@@ -257,6 +376,30 @@ def _bag_cases() -> list[Case]:
               id="bag-time-backwards"),
         _slam("t.bag", _bag("r.bag", scans=4, stamps=[10, 11, 11, 12]), "warn",
               id="bag-time-repeated"),
+        _slam("t.bag", _bag("l.bag", scans=4, stamps=[10, 11, 10**9, 10**9 + 1]), "warn",
+              ["t.bag: scan 2"], id="bag-time-leap"),
+        # readings: NaN and inf are REP 117's codes (no return), negative ones none
+        _slam("t.bag", _bag("a.bag", ranges=readings(nan)), "warn", id="bag-ranges-all-nan"),
+        _slam("t.bag", _bag("a.bag", ranges=readings(inf)), "warn", id="bag-ranges-all-inf"),
+        _slam("t.bag", _bag("a.bag", ranges=some(-1.0)), "warn", id="bag-ranges-negative"),
+        _slam("t.bag", _bag("a.bag", ranges=some(1e6)), "warn", id="bag-ranges-1e6"),
+        # what no laser states, no odometry gives
+        _slam("t.bag", _bag("m.bag", range_max=0.0), names=scan0, id="bag-range-max-0"),
+        _slam("t.bag", _bag("m.bag", range_max=-1.0), names=scan0, id="bag-range-max-negative"),
+        _slam("t.bag", _bag("m.bag", range_max=nan), names=scan0, id="bag-range-max-nan"),
+        _slam("t.bag", _bag("m.bag", range_max=inf), names=scan0, id="bag-range-max-inf"),
+        _slam("t.bag", _bag("i.bag", increment=0.0), names=scan0, id="bag-increment-0"),
+        _slam("t.bag", _bag("i.bag", increment=10.0), names=scan0, id="bag-increment-10-rad"),
+        _slam("t.bag", _bag("i.bag", increment=nan), names=scan0, id="bag-increment-nan"),
+        _slam("t.bag", _bag("o.bag", beams=1), names=scan0, id="bag-one-beam"),
+        _slam("t.bag", _bag("o.bag", odom_x=lambda k: nan if k == 1 else 0.1 * k),
+              names=[*odom, "message 1"], id="bag-odometry-nan"),
+        _slam("t.bag", _bag("q.bag", quaternion=(0, 0, 0, nan)), names=odom,
+              id="bag-quaternion-nan"),
+        _slam("t.bag", _bag("q.bag", quaternion=(0, 0, 0, 0)), names=odom,
+              id="bag-quaternion-zero"),
+        _slam("t.bag", _bag("q.bag", mount=(0.1, 0.0, (0, 0, 0, 0))),
+              names=["t.bag", "/tf_static"], id="bag-mount-quaternion-zero"),
     ]  # fmt: skip
 
 
@@ -271,6 +414,23 @@ def _path_cases() -> list[Case]:
         Case("unknown-dataset", ["slam", "nosuchlog", "--trajectory", "{d}/" + OUT], {},
              "error", ["nosuchlog"]),
         Case("info-missing", ["info", "{d}/none.clf"], {}, "error", ["none.clf"]),
+        # issue 13: a named pipe hung every command that read it (is_bag opened it)
+        Case("log-is-a-fifo", ["slam", "{d}/ff", "--trajectory", "{d}/" + OUT], {"ff": FIFO},
+             "error", ["ff: is not a regular file"]),
+        Case("info-fifo", ["info", "{d}/ff"], {"ff": FIFO}, "error", ["ff: is not a regular"]),
+        Case("info-fifo-bag", ["info", "{d}/ff.bag"], {"ff.bag": FIFO}, "error",
+             ["ff.bag: is not a regular file"]),
+        Case("info-fifo-db3", ["info", "{d}/ff.db3"], {"ff.db3": FIFO}, "error",
+             ["ff.db3: is not a regular file"]),
+        Case("bench-fifo", ["bench", "--log", "{d}/ff", "--quiet"], {"ff": FIFO}, "error",
+             ["ff: is not a regular file"]),
+        # issue 13: a registered dataset with relations only ended in a traceback
+        Case("slam-relations-only-dataset", ["slam", "mit-killian", "--trajectory",
+             "{d}/" + OUT], {}, "error", ["dataset 'mit-killian' has only relations"]),
+        Case("info-relations-only-dataset", ["info", "mit-killian"], {}, "error",
+             ["dataset 'mit-killian' has only relations", "--relations mit-killian"]),
+        Case("bench-relations-only-dataset", ["bench", "--log", "mit-killian", "--quiet"], {},
+             "error", ["dataset 'mit-killian' has only relations"]),
         Case("output-is-the-input", [*slam, "--trajectory", "{d}/log.clf"],
              {"log.clf": good}, "error", ["log.clf"]),
         Case("output-twice", [*slam, "--trajectory", "{d}/o.txt", "--map", "{d}/o.txt"],
@@ -440,6 +600,8 @@ def _materialise(case: Case, d: Path) -> list[str]:
         p = d / name
         if name.endswith("/"):
             p.mkdir()
+        elif content is FIFO:
+            os.mkfifo(p)
         elif isinstance(content, bytes):
             p.write_bytes(content)
         else:
@@ -491,13 +653,22 @@ def _check(case: Case, d: Path, inputs, code: int, out: str, err: str) -> None:
 @pytest.mark.skipif(not hasattr(signal, "SIGALRM"), reason="the time limit needs SIGALRM")
 @pytest.mark.parametrize("case", CASES, ids=[c.id for c in CASES])
 def test_every_hostile_input_ends_cleanly(case, tmp_path, capsys):
+    if FIFO in case.files.values() and not hasattr(os, "mkfifo"):
+        pytest.skip("no named pipes on this platform")
     argv = _materialise(case, tmp_path)
     inputs = _snapshot(tmp_path)
     code, out, err = _run(case, argv, capsys)
     _check(case, tmp_path, inputs, code, out, err)
 
 
-SAMPLE = ["clf-range-nan", "clf-binary", "bag-truncated", "output-is-the-input", "world-binary"]
+SAMPLE = [
+    "clf-range-nan",
+    "clf-binary",
+    "bag-truncated",
+    "output-is-the-input",
+    "world-binary",
+    "log-is-a-fifo",
+]
 
 
 @pytest.mark.parametrize("case_id", SAMPLE)

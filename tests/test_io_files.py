@@ -91,3 +91,53 @@ def test_check_outputs_refuses_one_output_twice_and_accepts_distinct_ones(tmp_pa
         {"the input world file": None, "the input log": "intel"},
     )
     assert not (tmp_path / "t.txt").exists()
+
+
+def _readers():
+    """Every reader of a file the ``fhslam`` command takes, as ``(name, call)``."""
+    from fhslam.datasets import load_log
+    from fhslam.io import read_bag, read_carmen, read_graph, read_relations
+    from fhslam.sim import load_world
+
+    return [
+        ("load_log", load_log),
+        ("read_carmen", read_carmen),
+        ("read_bag", read_bag),
+        ("read_trajectory", read_trajectory),
+        ("read_relations", read_relations),
+        ("read_map", read_map),
+        ("read_graph", read_graph),
+        ("load_world", load_world),
+    ]
+
+
+@pytest.mark.skipif(not hasattr(os, "mkfifo"), reason="no FIFOs on this platform")
+@pytest.mark.parametrize("suffix", ["", ".clf", ".bag", ".db3", ".json", ".txt"])
+def test_no_reader_opens_a_fifo(tmp_path, suffix):
+    """Issue 13: ``mkfifo ff; fhslam info ff`` hung for ever, since ``is_bag`` opened the
+    FIFO (waiting for a writer) before any reader checked it is a regular file. Every reader
+    refuses it, naming it, without opening it; ``is_bag`` says no."""
+    import signal
+
+    from fhslam.io import is_bag
+
+    fifo = tmp_path / f"ff{suffix}"
+    os.mkfifo(fifo)
+
+    class Blocked(Exception):  # not an OSError, which a reader might catch
+        pass
+
+    def hang(signum, frame):
+        raise Blocked("a reader opened the FIFO and blocked")
+
+    previous = signal.signal(signal.SIGALRM, hang)
+    signal.alarm(10)
+    try:
+        assert not is_bag(fifo)
+        for name, read in _readers():
+            with pytest.raises(InputError, match=rf"ff{suffix}: is not a regular file") as e:
+                read(fifo)
+            assert not isinstance(e.value, MissingInputError), name
+    finally:
+        signal.alarm(0)
+        signal.signal(signal.SIGALRM, previous)

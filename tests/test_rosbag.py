@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import warnings
+
 import numpy as np
 import pytest
 
@@ -10,18 +12,39 @@ from fhslam.metrics import relations_error
 
 
 def _types():
-    from rosbags.typesys import Stores, get_typestore
+    """ROS 1 Noetic's message types, with tf2_msgs/TFMessage (which rosbags lacks)."""
+    from rosbags.typesys import Stores, get_types_from_msg, get_typestore
 
-    return get_typestore(Stores.ROS1_NOETIC)
+    ts = get_typestore(Stores.ROS1_NOETIC)
+    tf = "geometry_msgs/TransformStamped[] transforms"
+    ts.register(get_types_from_msg(tf, "tf2_msgs/msg/TFMessage"))
+    return ts
 
 
 def write_bag(
-    path, scans=3, odom=True, scan_topics=("/scan",), beams=181, interlaced=False, stamps=None
+    path,
+    scans=3,
+    odom=True,
+    scan_topics=("/scan",),
+    beams=181,
+    interlaced=False,
+    stamps=None,
+    ranges=None,
+    range_max=80.0,
+    increment=None,
+    odom_x=None,
+    quaternion=(0.0, 0.0, 0.0, 1.0),
+    mount=None,
 ):
     """A tiny ROS 1 bag: scans of a wall 2 m ahead, odometry moving 0.1 m per scan.
     ``interlaced``: scan k starts (k mod 4) quarter-beams later, with one beam fewer after
     the first (as the Freiburg hospital log's laser). ``stamps``: the scans' (and odometry's)
-    header stamps in whole seconds (default 10, 11, ...; the bag records message k at 10 + k s)."""
+    header stamps in whole seconds (default 10, 11, ...; the bag records message k at 10 + k s).
+    ``ranges(k, a)``: scan k's readings at bearings ``a`` instead of the wall; ``range_max``
+    and ``increment`` (default π/(beams−1)): the scans' ``range_max`` and
+    ``angle_increment``; ``odom_x(k)``: odometry message k's x (default 0.1 k);
+    ``quaternion``: every odometry orientation ``(x, y, z, w)``; ``mount``: ``(x, y,
+    (qx, qy, qz, qw))``, a ``/tf_static`` message base_link → laser."""
     from rosbags.rosbag1 import Writer
 
     ts = _types()
@@ -38,15 +61,36 @@ def write_bag(
     with Writer(path) as w:
         conns = [w.add_connection(t, scan_t, typestore=ts) for t in scan_topics]
         oc = w.add_connection("/odom", odom_t, typestore=ts) if odom else None
+        if mount is not None:
+            tf_t = "tf2_msgs/msg/TFMessage"
+            x, y, q = mount
+            tf = T[tf_t](
+                transforms=[
+                    T["geometry_msgs/msg/TransformStamped"](
+                        header=header(0),
+                        child_frame_id="laser",
+                        transform=T["geometry_msgs/msg/Transform"](
+                            translation=T["geometry_msgs/msg/Vector3"](x=x, y=y, z=0.0),
+                            rotation=T["geometry_msgs/msg/Quaternion"](
+                                **dict(zip("xyzw", map(float, q), strict=True))
+                            ),
+                        ),
+                    )
+                ]
+            )
+            tc = w.add_connection("/tf_static", tf_t, typestore=ts)
+            w.write(tc, 10 * 10**9, ts.serialize_ros1(tf, tf_t))
         for k in range(scans):
-            inc = np.pi / (beams - 1)
+            inc = (np.pi / max(beams - 1, 1)) if increment is None else increment
             shift = (k % 4) * inc / 4 if interlaced else 0.0
             a = -np.pi / 2 + shift + inc * np.arange(beams - (shift > 0))
-            r = np.where(np.abs(a) < 1.0, 2.0 / np.cos(a), 81.9).astype(np.float32)
+            r = np.where(np.abs(a) < 1.0, 2.0 / np.cos(a), 81.9) if ranges is None else ranges(k, a)
+            r = np.asarray(r, dtype=np.float32)
+            a_min, a_max = (float(a[0]), float(a[-1])) if len(a) else (-np.pi / 2, -np.pi / 2)
             msg = T[scan_t](
-                header=header(k), angle_min=a[0], angle_max=a[-1],
+                header=header(k), angle_min=a_min, angle_max=a_max,
                 angle_increment=inc, time_increment=0.0, scan_time=0.0, range_min=0.0,
-                range_max=80.0, ranges=r, intensities=np.zeros(0, np.float32),
+                range_max=range_max, ranges=r, intensities=np.zeros(0, np.float32),
             )  # fmt: skip
             for c in conns:
                 w.write(c, (10 + k) * 10**9, ts.serialize_ros1(msg, scan_t))
@@ -54,8 +98,12 @@ def write_bag(
                 g = T
                 pose = g["geometry_msgs/msg/PoseWithCovariance"](
                     pose=g["geometry_msgs/msg/Pose"](
-                        position=g["geometry_msgs/msg/Point"](x=0.1 * k, y=0.0, z=0.0),
-                        orientation=g["geometry_msgs/msg/Quaternion"](x=0.0, y=0.0, z=0.0, w=1.0),
+                        position=g["geometry_msgs/msg/Point"](
+                            x=0.1 * k if odom_x is None else odom_x(k), y=0.0, z=0.0
+                        ),
+                        orientation=g["geometry_msgs/msg/Quaternion"](
+                            **dict(zip("xyzw", map(float, quaternion), strict=True))
+                        ),
                     ),
                     covariance=np.zeros(36),
                 )
@@ -186,3 +234,129 @@ def test_scans_out_of_time_order_are_sorted_with_a_warning(tmp_path):
     )
     assert "b.bag: scan 3: the timestamp repeats from scan 2 (12.0 -> 12.0)" in messages[1]
     np.testing.assert_array_equal(log.timestamps, [10, 11, 12, 12, 13])
+
+
+def _wall_and_far_wall(k, a):
+    """A wall 2 m ahead within ±1 rad, another reading exactly 3.0 m beyond: the same scan
+    every time (a robot standing still), so every reading repeats exactly."""
+    return np.where(np.abs(a) < 1.0, 2.0 / np.cos(a), 3.0)
+
+
+def test_a_reading_repeated_far_below_range_max_is_no_no_return_code(tmp_path):
+    """Issue 13: a bag stating range_max 80 m whose 30 scans repeat took the 2.0 m straight
+    ahead (read 30 times) for the no-return code: every reading at or beyond 2 m was
+    dropped, every scan empty. A code is sought in the upper half of the stated range."""
+    from fhslam.io import no_return_reading
+
+    path = write_bag(tmp_path / "still.bag", scans=30, ranges=_wall_and_far_wall)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # no "no scan has a return" any more
+        log = read_bag(path)
+    assert log.max_range == 80.0 and log.stated_max_range == 80.0
+    assert no_return_reading(log.ranges) == 2.0  # what the readings alone suggest
+    assert no_return_reading(log.ranges, stated=80.0) is None
+    assert len(log.scan(0).points()[0]) == 181  # every beam a point
+
+
+def test_a_code_near_range_max_is_still_found(tmp_path):
+    """A code in the upper half of the stated range still sets the maximum range: the
+    write_bag scans code no return beyond ±1 rad as 81.9 m above range_max 80 (the range in
+    use: 80), and as 79.5 m below a range_max of 100 m (the range in use: the code)."""
+    assert read_bag(write_bag(tmp_path / "a.bag")).max_range == 80.0
+
+    def coded(k, a):
+        return np.where(np.abs(a) < 1.0, 2.0 / np.cos(a), 79.5)
+
+    log = read_bag(write_bag(tmp_path / "b.bag", scans=30, ranges=coded, range_max=100.0))
+    assert log.max_range == pytest.approx(79.5) and log.stated_max_range == 100.0
+
+
+@pytest.mark.parametrize(
+    ("kw", "message"),
+    [
+        ({"range_max": 0.0}, r"scan 0 of topic '/scan': range_max 0 m is no laser's range"),
+        ({"range_max": -1.0}, r"scan 0 of topic '/scan': range_max -1 m is no laser's"),
+        ({"range_max": float("nan")}, r"scan 0 of topic '/scan': range_max nan m is no laser"),
+        ({"range_max": float("inf")}, r"scan 0 of topic '/scan': range_max inf m is no laser"),
+        ({"range_max": 1e6}, r"range_max 1e\+06 m is no laser's range: it must be below"),
+        ({"increment": 0.0}, r"scan 0 of topic '/scan': angle_increment 0 rad: the angle"),
+        ({"increment": -0.25}, r"angle_increment -0\.25 rad: the angle between beams must"),
+        ({"increment": float("nan")}, r"scan 0 of topic '/scan': angle_min nan rad"),
+        ({"increment": 10.0}, r"angle_increment 10 rad spreads its 181 beams over 103132 deg"),
+        ({"beams": 1}, r"scan 0 of topic '/scan': the widest scan has 1 beam; a laser scan"),
+        ({"beams": 0}, r"the widest scan has 0 beams; a laser scan has at least 2"),
+        (
+            {"odom_x": lambda k: float("nan") if k == 2 else 0.1 * k},
+            r"odometry message 2 of topic '/odom': non-finite position \(x nan, y 0\.0\)",
+        ),
+        (
+            {"quaternion": (0, 0, 0, float("nan"))},
+            r"odometry message 0 of topic '/odom': non-finite orientation quaternion",
+        ),
+        (
+            {"quaternion": (0, 0, 0, 0)},
+            r"odometry message 0 of topic '/odom': orientation quaternion \[0\.0, 0\.0, 0\.0, "
+            r"0\.0\] is not a rotation: its squared norm 0 is not 1",
+        ),
+        ({"quaternion": (0, 0, 0, 2)}, r"its squared norm 4 is not 1 \(within 0\.01\)"),
+        (
+            {"mount": (0.1, 0.0, (0, 0, float("nan"), 1))},
+            r"message 0 of topic '/tf_static', the laser mount 'laser': non-finite orientation",
+        ),
+        (
+            {"mount": (float("inf"), 0.0, (0, 0, 0, 1))},
+            r"the laser mount 'laser': non-finite position \(x inf",
+        ),
+    ],
+    ids=[
+        "range-max-0", "range-max-negative", "range-max-nan", "range-max-inf", "range-max-1e6",
+        "increment-0", "increment-negative", "increment-nan", "increment-10-rad", "one-beam",
+        "no-beam", "odometry-nan", "quaternion-nan", "quaternion-zero", "quaternion-norm-2",
+        "mount-quaternion-nan", "mount-inf",
+    ],
+)  # fmt: skip
+def test_what_no_laser_or_odometry_gives_is_refused_naming_the_message(tmp_path, kw, message):
+    """Issue 13: range_max 0, -1 or NaN ended in a traceback (Log.max_range must be
+    positive), a NaN pose in another (odometry must be finite), one beam in a
+    ZeroDivisionError; an increment of 0 or 10 rad and an all-zero quaternion (read as
+    heading 0) were read silently."""
+    path = write_bag(tmp_path / "x.bag", scans=4, **kw)
+    with pytest.raises(BagFormatError, match=r"x\.bag: .*" + message):
+        read_bag(path)
+
+
+def test_ros_no_return_codes_are_read_without_a_warning(tmp_path):
+    """REP 117: +inf is no return, -inf too close, NaN invalid; the reader reads them as no
+    return without calling them implausible (before: +inf was "beyond 1000 m"). A negative
+    reading is no code: warned."""
+    from fhslam.io import BagWarning
+
+    def coded(k, a):
+        r = np.where(np.abs(a) < 1.0, 2.0 / np.cos(a), np.inf)
+        r[:3] = [-np.inf, np.nan, np.inf]
+        return r
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        log = read_bag(write_bag(tmp_path / "a.bag", ranges=coded))
+    assert log.max_range == 80.0 and len(log.scan(0).points()[0]) == 115
+
+    def negative(k, a):
+        return np.where(np.abs(a) < 1.0, -1.0, 3.0)
+
+    with pytest.warns(BagWarning, match=r"b\.bag: scan 0: 345 readings in 3 scans are negative"):
+        read_bag(write_bag(tmp_path / "b.bag", ranges=negative))
+
+
+def test_a_leap_of_more_than_a_day_is_warned(tmp_path):
+    """Issue 13: time going back was warned, a leap forward of 1e9 s was not."""
+    from fhslam.io import BagWarning
+
+    path = write_bag(tmp_path / "t.bag", scans=4, stamps=[10, 11, 10**9, 10**9 + 1])
+    with pytest.warns(BagWarning) as rec:
+        log = read_bag(path)
+    assert [str(w.message) for w in rec] == [
+        f"{path}: scan 2: time leaps forward more than a day (86400 s) from scan 1 "
+        "(11.0 -> 1000000000.0); read as it is"
+    ]
+    assert len(log) == 4

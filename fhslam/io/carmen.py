@@ -61,6 +61,21 @@ must be ``fov / resolution + 1`` (or one less: the last beam dropped). ``ROBOTLA
 lines state their own start angle and resolution, which these ``PARAM`` lines do not
 override.
 
+A ``ROBOTLASER1`` line states what no laser has, and is a :class:`CarmenFormatError` naming
+the line, if its header holds a non-finite value, a ``start_angle`` beyond ±2π (radians,
+not degrees), an ``angular_resolution`` that is not positive or that spreads the beams over
+more than 360°, or a ``maximum_range`` that is not a positive number of metres below
+1000 m (:func:`fhslam.io.log.stated_range_problem`): such a line is corrupt, and ignoring
+the one field would only hide it.
+
+The maximum range in use (``Log.max_range``; readings at or beyond it are no returns): the
+log's no-return code, the value read over and over at the top of the readings
+(:func:`fhslam.io.log.no_return_reading`, e.g. 81.91 m in mit-csail); for ``ROBOTLASER1``
+its stated ``maximum_range`` if that is smaller, and the code is only sought in the upper
+half of the stated range (a value read over and over far below it is a distance measured
+often, not a code). A ``FLASER`` log without a code gets CARMEN's assumption, 80 m (or
+more, above its largest reading).
+
 A ``PARAM`` of one of these five names without a value, with a non-numeric or non-finite
 value, with an angle out of range (a resolution or field of view outside (0°, 360°], an
 angular offset beyond ±2π, i.e. given in degrees), or stated twice with different values
@@ -86,6 +101,7 @@ from fhslam.io.log import (
     check_sequence,
     effective_max_range,
     is_number,
+    stated_range_problem,
 )
 
 HOSTNAME = "fhslam"
@@ -373,12 +389,35 @@ def _parse_robotlaser1(fields: list[str], where: str) -> _Parsed:
                 f"{24 + n + m} fields, found {len(fields)} (truncated line or wrong count)"
             )
         tail = fields[10 + n + m :]
+    _check_robotlaser1_head(start, res, max_range, n, where)
     ranges = _floats(fields[9 : 9 + n], "range reading", where)
     poses = _floats(tail[0:6], "pose value", where)
     _check_finite(poses, "pose", where)
     stamp = _floats([tail[11]], "ipc_timestamp", where)
     _check_finite(stamp, "ipc_timestamp", where)
     return float(stamp[0]), ranges, poses[3:6], poses[0:3], np.array([start, res, max_range])
+
+
+def _check_robotlaser1_head(start: float, res: float, max_range: float, n: int, where: str):
+    """Refuse a ``ROBOTLASER1`` header no laser states (see the module docstring)."""
+    if abs(start) > 2 * math.pi:
+        raise CarmenFormatError(
+            f"{where}: ROBOTLASER1 start_angle {start:g} is more than a full turn: CARMEN "
+            "states it in radians, not degrees"
+        )
+    if res <= 0:
+        raise CarmenFormatError(
+            f"{where}: ROBOTLASER1 angular_resolution {res:g} rad: the angle between beams "
+            "must be positive"
+        )
+    if (n - 1) * res > 2 * math.pi + 1e-9:
+        raise CarmenFormatError(
+            f"{where}: ROBOTLASER1 angular_resolution {res:g} rad spreads its {n} beams over "
+            f"{math.degrees((n - 1) * res):g} degrees, more than a full turn"
+        )
+    problem = stated_range_problem(max_range)
+    if problem is not None:
+        raise CarmenFormatError(f"{where}: ROBOTLASER1 maximum_range {problem}")
 
 
 @dataclass(frozen=True)
@@ -513,8 +552,8 @@ def read_carmen(path: str | PathLike[str], max_range: float | None = None) -> Lo
         The laser's maximum range in metres (readings at or beyond it mean "no return").
         Default: the log's "no return" code (:func:`fhslam.io.log.no_return_reading`, e.g.
         81.91 m in mit-csail), or for ``ROBOTLASER1`` its ``maximum_range`` field if that is
-        smaller; a ``FLASER`` log without a code gets CARMEN's assumption for ``FLASER``,
-        80 m (or more, above its largest reading).
+        smaller (a code far below that field is none); a ``FLASER`` log without a code gets
+        CARMEN's assumption for ``FLASER``, 80 m (or more, above its largest reading).
 
     Returns
     -------
@@ -525,7 +564,8 @@ def read_carmen(path: str | PathLike[str], max_range: float | None = None) -> Lo
         (with the log's resolution and field-of-view ``PARAM`` lines, if any),
         ``start_angle + k * angular_resolution`` for ``ROBOTLASER1``; ``laser_offset`` the
         laser's mount and ``laser_offset_source`` where it came from, ``"PARAM"``,
-        ``"laser pose"`` or ``"none"`` (the rule is in the module docstring). No truth.
+        ``"laser pose"`` or ``"none"`` (the rule is in the module docstring);
+        ``stated_max_range`` the ``maximum_range`` of the first ``ROBOTLASER1`` line. No truth.
 
     Raises
     ------
@@ -533,7 +573,10 @@ def read_carmen(path: str | PathLike[str], max_range: float | None = None) -> Lo
         If ``path`` does not exist.
     CarmenFormatError
         ``"{path}:{lineno}: ..."`` for a malformed laser line (truncated, non-numeric field,
-        wrong reading count, non-finite pose), a beam count differing from the first scan's,
+        wrong reading count, non-finite pose), a ``ROBOTLASER1`` header no laser states (a
+        start angle beyond ±2π, a resolution that is not positive or spans more than 360°, a
+        maximum range that is not a positive number below 1000 m), a beam count differing
+        from the first scan's,
         a malformed or contradictory ``PARAM`` of the mount or beam layout, a resolution
         that spreads the beams over more than 360° (or that contradicts the stated field of
         view), or a file with no laser messages or with both FLASER and ROBOTLASER1.
@@ -542,7 +585,8 @@ def read_carmen(path: str | PathLike[str], max_range: float | None = None) -> Lo
     -----
     CarmenWarning
         When the ``PARAM`` mount and the constant offset of the laser poses disagree; where
-        the scans' time runs backwards or repeats or the odometry jumps
+        the scans' time runs backwards, repeats or leaps forward more than a day, or the
+        odometry jumps
         (:func:`fhslam.io.log.check_sequence`); for readings that are negative, NaN,
         infinite or beyond 1000 m (read as no return), scans without a return, more than
         10,000 beams (:func:`fhslam.io.log.check_readings`). Each names the file and line.
@@ -599,12 +643,13 @@ def read_carmen(path: str | PathLike[str], max_range: float | None = None) -> Lo
 
     kind, first_line, n, geom = first
     r = np.vstack(ranges)
+    stated = None if kind == "FLASER" else float(geom[2])
     if kind == "FLASER":
         angles = _flaser_layout(path, params, n, first_line)
         inferred, _ = effective_max_range(r, None, FLASER_MAX_RANGE)
     else:
         angles = geom[0] + np.arange(n) * geom[1]
-        inferred, _ = effective_max_range(r, float(geom[2]), float(geom[2]))
+        inferred, _ = effective_max_range(r, stated, stated)
     odo = np.vstack(odometry)
     max_range = inferred if max_range is None else float(max_range)
     check_sequence(path, np.array(stamps), odo, scan_lines, CarmenWarning)
@@ -619,4 +664,5 @@ def read_carmen(path: str | PathLike[str], max_range: float | None = None) -> Lo
         max_range=max_range,
         laser_offset=mount,
         laser_offset_source=source,
+        stated_max_range=stated,
     )

@@ -60,6 +60,11 @@ class Log:
         Where the reader found ``laser_offset``: for a CARMEN log ``"PARAM"``,
         ``"laser pose"`` or ``"none"`` (:func:`fhslam.io.read_carmen`), for a bag
         ``"tf_static"``; ``None``: not recorded (simulated logs).
+    stated_max_range : float or None
+        The maximum range the file itself states, metres (a bag's ``range_max``, a
+        ``ROBOTLASER1`` line's ``maximum_range``); ``None``: the file states none (``FLASER``,
+        simulated logs). It bounds the search for the no-return code
+        (:func:`no_return_reading`); ``max_range`` is the range in use.
     """
 
     name: str
@@ -74,6 +79,7 @@ class Log:
     laser_offset: NDArray[np.float64] | None = None
     angle_offsets: NDArray[np.float64] | None = None
     laser_offset_source: str | None = None
+    stated_max_range: float | None = None
 
     def __post_init__(self) -> None:
         self.laser_offset = (
@@ -145,14 +151,17 @@ NO_RETURN_MIN_SHARE = 1e-3
 :func:`no_return_reading` to take it as the "no return" code."""
 
 
-def no_return_reading(ranges: ArrayLike, min_share: float = NO_RETURN_MIN_SHARE) -> float | None:
+def no_return_reading(
+    ranges: ArrayLike, min_share: float = NO_RETURN_MIN_SHARE, stated: float | None = None
+) -> float | None:
     """The reading a log uses to say "no return", or ``None`` if it has none.
 
     A laser reports a beam without an echo as one fixed code, and a CARMEN ``FLASER`` line
     does not say which: 81.91 m (and 81.83 m) in the Freiburg logs of a SICK LMS in its
     80 m mode, 50.0 m in ACES, the maximum range in a simulated log. Real returns that far
-    are sparse and scattered; a code is one exact value read over and over. Among the values
-    in the upper half of the readings' scale (at least half the largest reading):
+    are sparse and scattered; a code is one exact value read over and over, at or near the
+    laser's maximum range. Among the values in the upper half of the readings' scale (at
+    least half the largest reading, or half the ``stated`` maximum range if that is more):
 
     1. the smallest value read by at least ``min_share`` of all valid beams (and by at least
        20) is the code;
@@ -162,12 +171,20 @@ def no_return_reading(ranges: ArrayLike, min_share: float = NO_RETURN_MIN_SHARE)
     The largest reading alone is no evidence: a few long noisy returns beyond the code would
     turn every no-return beam into a phantom point.
 
+    The ``stated`` range bounds the search from below: a value repeated far below it (less
+    than half) is a distance the laser measured often, not its no-return code. So in a bag
+    stating ``range_max`` 80 m whose scans repeat (a robot standing before a wall), a
+    wall at 2.0 m read in every scan is no code, while a SICK's 81.91 m and 81.83 m (the
+    Freiburg bags state 80 m and 81.9 m) and ACES's 50.0 m (it states 50 m) are.
+
     Parameters
     ----------
     ranges : array-like
         Every reading of the log, metres (NaN/inf and non-positive ones are ignored).
     min_share : float
         See above.
+    stated : float, optional
+        The maximum range the file states (:attr:`Log.stated_max_range`), metres.
 
     Returns
     -------
@@ -178,7 +195,10 @@ def no_return_reading(ranges: ArrayLike, min_share: float = NO_RETURN_MIN_SHARE)
     r = r[np.isfinite(r) & (r > 0)]
     if r.size == 0:
         return None
-    values, counts = np.unique(r[r >= 0.5 * r.max()], return_counts=True)
+    scale = r.max() if stated is None else max(r.max(), stated)
+    values, counts = np.unique(r[r >= 0.5 * scale], return_counts=True)
+    if values.size == 0:
+        return None
     spikes = values[counts >= max(20.0, min_share * r.size)]
     if spikes.size:
         return float(spikes[0])
@@ -191,14 +211,15 @@ def effective_max_range(
     ranges: ArrayLike, stated: float | None, default: float
 ) -> tuple[float, float | None]:
     """The maximum range a reader gives a log: the smaller of the range the file states
-    (``stated``, e.g. a bag's ``range_max``) and its detected no-return code
-    (:func:`no_return_reading`); with neither, ``default``, raised above the largest reading
+    (``stated``, e.g. a bag's ``range_max``; a plausible one, :func:`stated_range_problem`)
+    and its detected no-return code (:func:`no_return_reading`, searched near ``stated``:
+    never far below it); with neither, ``default``, raised above the largest reading
     if needed so that no real reading is dropped. Never more than :data:`IMPLAUSIBLE_RANGE`:
     a reading that far is no measurement (:func:`check_readings` warns of it). Returns
     ``(max_range, code)``."""
     r = np.asarray(ranges, dtype=float)
     r = r[np.isfinite(r) & (r < IMPLAUSIBLE_RANGE)]
-    code = no_return_reading(r)
+    code = no_return_reading(r, stated=stated)
     candidates = [v for v in (stated, code) if v is not None]
     if candidates:
         return min(*candidates, IMPLAUSIBLE_RANGE), code
@@ -220,6 +241,26 @@ log with more is read, with a warning (its ranges alone take 80 kB per scan)."""
 ODOMETRY_JUMP = 10.0
 """An odometry step longer than this between two scans, metres, is implausible: warned."""
 
+TIME_JUMP = 86_400.0
+"""A step forward in time longer than this between two scans, seconds (a day), is
+implausible: no log records a day without a scan (the five Freiburg logs' longest gap is
+198 s), so it is a corrupt timestamp, warned as time running backwards is."""
+
+
+def stated_range_problem(value: float) -> str | None:
+    """Why ``value`` cannot be the maximum range a laser states, or ``None`` if it can: it
+    must be a positive number of metres below :data:`IMPLAUSIBLE_RANGE` (NaN, 0, -1, inf and
+    1e308 are no laser's range). For the readers' messages."""
+    value = float(value)
+    if not np.isfinite(value) or value <= 0:
+        return f"{value:g} m is no laser's range: it must be a positive number of metres"
+    if value >= IMPLAUSIBLE_RANGE:
+        return (
+            f"{value:g} m is no laser's range: it must be below {IMPLAUSIBLE_RANGE:g} m "
+            "(no 2D laser measures that far)"
+        )
+    return None
+
 
 def plural(n: int, noun: str) -> str:
     """``"1 scan"``, ``"2 scans"``: a count for a message."""
@@ -234,16 +275,21 @@ def check_sequence(
     category: type[InputWarning] = InputWarning,
     noun: str = "scan",
 ) -> None:
-    """Warn where successive rows' time runs backwards or stands still, or (``odometry``
-    given) the odometry jumps further than :data:`ODOMETRY_JUMP`: one warning of
-    ``category`` per kind of finding, naming the file, the first place and how many more.
+    """Warn where successive rows' time runs backwards, stands still or leaps forward more
+    than :data:`TIME_JUMP` (a day), or (``odometry`` given) the odometry jumps further than
+    :data:`ODOMETRY_JUMP`: one warning of ``category`` per kind of finding, naming the file,
+    the first place and how many more.
 
     ``lines`` is the file line of each row (``None``: rows are named by their index, e.g.
     ``scan 4``). Nothing is changed: the caller reads the input as it is and says so.
     """
     t = np.asarray(t, dtype=float)
     dt = np.diff(t)
-    checks = [(dt < 0, "time goes backwards"), (dt == 0, "the timestamp repeats")]
+    checks = [
+        (dt < 0, "time goes backwards"),
+        (dt == 0, "the timestamp repeats"),
+        (dt > TIME_JUMP, f"time leaps forward more than a day ({TIME_JUMP:g} s)"),
+    ]
     if odometry is not None:
         step = np.hypot(*np.diff(np.asarray(odometry)[:, :2], axis=0).T)
         checks.append((step > ODOMETRY_JUMP, f"the odometry jumps more than {ODOMETRY_JUMP:g} m"))
@@ -253,7 +299,7 @@ def check_sequence(
         k = int(np.flatnonzero(bad)[0])
         more = f" (and at {plural(int(bad.sum()) - 1, 'more ' + noun)})" if bad.sum() > 1 else ""
         detail = (
-            f"{step[k]:.6g} m" if "jumps" in what else f"{float(t[k])!r} -> {float(t[k + 1])!r}"
+            f"{step[k]:.6g} m" if "odometry" in what else f"{float(t[k])!r} -> {float(t[k + 1])!r}"
         )
         if lines is None:
             where = f"{path}: {noun} {k + 1}: {what} from {noun} {k}"
@@ -273,8 +319,9 @@ def check_readings(
     """Warn of a log's implausible readings and of scans without a single return.
 
     One warning of ``category`` for each of: readings that are negative, at or beyond
-    :data:`IMPLAUSIBLE_RANGE`, or (``non_finite``; ROS bags code no return as inf and invalid
-    as NaN, REP 117, so they pass ``False``) NaN or infinite, all read as no return; scans
+    :data:`IMPLAUSIBLE_RANGE`, or (``non_finite``; ROS bags code no return as +inf, too close
+    as -inf and invalid as NaN, REP 117, so they pass ``False`` and these go unwarned) NaN or
+    infinite, all read as no return; scans
     in which no beam returns (nothing to extract or match: SLAM carries the odometry
     across them); and more beams per scan than :data:`PLAUSIBLE_BEAMS`. Each names the file
     and the first scan (its file line, or its index when ``lines`` is ``None``).
@@ -287,8 +334,7 @@ def check_readings(
 
     with np.errstate(invalid="ignore"):
         odd = (r < 0) | (r >= IMPLAUSIBLE_RANGE)
-        if non_finite:
-            odd |= ~np.isfinite(r)
+        odd = odd | ~np.isfinite(r) if non_finite else odd & np.isfinite(r)  # ±inf: REP 117
         empty = ~np.any(np.isfinite(r) & (r > 0) & (r < max_range), axis=1)
     if odd.any():
         rows = odd.any(axis=1)

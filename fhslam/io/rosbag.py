@@ -15,7 +15,21 @@ from ``ROBOTLASER1`` lines, which state it) is taken as it is.
 
 Maximum range: the bag's ``range_max``, or the log's detected "no return" code if smaller
 (:func:`fhslam.io.log.no_return_reading`; the Freiburg hospital bag states 81.9 m but codes
-no return as 81.83 and 81.91 m).
+no return as 81.83 and 81.91 m). The code is sought in the upper half of ``range_max``
+only: a value read over and over far below it (a wall 2 m ahead in every scan of a robot
+standing still) is a distance, not a code.
+
+What no laser or odometry gives is a :class:`BagFormatError` naming the file, the topic and
+the message (counted from 0 in the bag's order): a scan whose ``range_max`` is not a positive
+number of metres below 1000 m (:func:`fhslam.io.log.stated_range_problem`: 0, -1, NaN,
+inf), whose ``angle_min`` is not finite or beyond ±2π, whose ``angle_increment`` is not
+positive (0, negative, NaN) or spreads its beams over more than 360°; a bag whose widest
+scan has fewer than two beams; an odometry pose (or the ``/tf_static`` laser mount) with a
+non-finite position or a quaternion that is not finite or not of unit length (tf2's rule:
+its squared norm within 0.01 of 1; an all-zero quaternion is no rotation). Ignoring such a
+field would only hide a corrupt bag. Readings of +inf, -inf and NaN are REP 117's codes
+(no return, too close, invalid): no returns, without a warning.
+
 An interlaced laser, whose scans share the increment but start up to one beam apart (the
 Freiburg hospital log: four layouts a quarter degree apart, 181 or 180 beams), is read with
 the first layout's bearings and a per-scan ``Log.angle_offsets``; other mixed layouts are
@@ -35,7 +49,14 @@ from fhslam.errors import InputError, InputWarning
 from fhslam.geometry import wrap_angle
 from fhslam.io.carmen import flaser_angles
 from fhslam.io.files import input_path
-from fhslam.io.log import Log, check_readings, check_sequence, effective_max_range, plural
+from fhslam.io.log import (
+    Log,
+    check_readings,
+    check_sequence,
+    effective_max_range,
+    plural,
+    stated_range_problem,
+)
 
 SCAN_TYPE = "sensor_msgs/msg/LaserScan"
 ODOM_TYPE = "nav_msgs/msg/Odometry"
@@ -55,6 +76,8 @@ def is_bag(path: str | PathLike[str]) -> bool:
     p = Path(path)
     if p.is_dir():
         return (p / "metadata.yaml").exists()
+    if not p.is_file():  # missing, or a FIFO or device: opening it may block forever
+        return False
     if p.suffix in (".db3", ".mcap"):
         return True
     try:
@@ -66,6 +89,47 @@ def is_bag(path: str | PathLike[str]) -> bool:
 
 def _yaw(q) -> float:
     return float(np.arctan2(2.0 * (q.w * q.z + q.x * q.y), 1.0 - 2.0 * (q.y**2 + q.z**2)))
+
+
+QUATERNION_TOLERANCE = 0.01
+"""How far a quaternion's squared norm may be from 1 (tf2 refuses a transform beyond it)."""
+
+
+def _pose_problem(position, q) -> str | None:
+    """Why a ``(position, orientation)`` is no pose a robot can have, or ``None``."""
+    xy = (float(position.x), float(position.y))
+    if not all(np.isfinite(xy)):
+        return f"non-finite position (x {xy[0]!r}, y {xy[1]!r})"
+    quat = np.array([q.x, q.y, q.z, q.w], dtype=float)
+    if not np.all(np.isfinite(quat)):
+        return f"non-finite orientation quaternion {quat.tolist()}"
+    norm2 = float(quat @ quat)
+    if abs(norm2 - 1.0) > QUATERNION_TOLERANCE:
+        return (
+            f"orientation quaternion {quat.tolist()} is not a rotation: its squared norm "
+            f"{norm2:.6g} is not 1 (within {QUATERNION_TOLERANCE:g})"
+        )
+    return None
+
+
+def _scan_problem(m) -> str | None:
+    """Why a ``LaserScan`` message states a layout or range no laser has, or ``None``."""
+    problem = stated_range_problem(float(m.range_max))
+    if problem is not None:
+        return f"range_max {problem}"
+    a0, inc, n = float(m.angle_min), float(m.angle_increment), len(m.ranges)
+    if not (np.isfinite(a0) and abs(a0) <= 2 * np.pi):
+        return f"angle_min {a0:g} rad is not an angle within a full turn"
+    if n < 2:
+        return None  # no layout to check (the reader refuses a bag without a wider scan)
+    if not (np.isfinite(inc) and inc > 0):
+        return f"angle_increment {inc:g} rad: the angle between beams must be positive"
+    if (n - 1) * inc > 2 * np.pi + 1e-6:
+        return (
+            f"angle_increment {inc:g} rad spreads its {n} beams over "
+            f"{np.degrees((n - 1) * inc):g} degrees, more than a full turn"
+        )
+    return None
 
 
 def _pick(reader, msgtype: str, topic: str | None, what: str, path: Path):
@@ -113,15 +177,18 @@ def read_bag(
     ------
     BagFormatError
         No scans, no odometry, ambiguous or unknown topics, odometry that does not cover
-        the scans, or scans whose angle layouts differ.
+        the scans, scans whose angle layouts differ, or what no laser or odometry gives
+        (module docs): a bad ``range_max``, ``angle_min`` or ``angle_increment``, scans of
+        fewer than two beams, a non-finite pose or a quaternion that is no rotation.
 
     Warns
     -----
     BagWarning
-        Scans whose header stamps are out of order in the bag (they are sorted by stamp) or
-        repeat; odometry jumps; negative readings or readings beyond 1000 m (read as no
-        return; NaN and inf are ROS's own codes, REP 117); scans without a return; more
-        than 10,000 beams (:func:`fhslam.io.log.check_readings`).
+        Scans whose header stamps are out of order in the bag (they are sorted by stamp),
+        repeat or leap forward more than a day; odometry jumps; negative readings or
+        readings beyond 1000 m (read as no return; NaN and ±inf are ROS's own codes,
+        REP 117, read as no return without a warning); scans without a return; more than
+        10,000 beams (:func:`fhslam.io.log.check_readings`).
     """
     from rosbags.highlevel import AnyReader
     from rosbags.typesys import Stores, get_typestore
@@ -130,8 +197,8 @@ def read_bag(
     if beams not in ("carmen", "bag"):
         raise ValueError(f"beams must be 'carmen' or 'bag', got {beams!r}")
     p = Path(path)
-    if not p.exists():
-        input_path(p, "bag")  # raises MissingInputError
+    if not p.is_dir():  # a ROS 2 bag is a folder; else a regular file (a FIFO would block)
+        input_path(p, "bag")  # raises MissingInputError, or InputError for a non-file
     try:
         reader = AnyReader([p], default_typestore=get_typestore(Stores.ROS1_NOETIC))
         reader.open()
@@ -141,8 +208,13 @@ def read_bag(
         scan_conns = _pick(reader, SCAN_TYPE, scan_topic, "laser scan", p)
         odom_conns = _pick(reader, ODOM_TYPE, odom_topic, "odometry", p)
         stamps, ranges, layout, max_range, starts = [], [], set(), 0.0, []
-        for conn, _t, raw in reader.messages(connections=scan_conns):
+        widest = (0, 0)  # beams, scan index
+        for k, (conn, _t, raw) in enumerate(reader.messages(connections=scan_conns)):
             m = reader.deserialize(raw, conn.msgtype)
+            problem = _scan_problem(m)
+            if problem is not None:
+                raise BagFormatError(f"{p}: scan {k} of topic {conn.topic!r}: {problem}")
+            widest = max(widest, (len(m.ranges), -k))
             stamps.append(m.header.stamp.sec + 1e-9 * m.header.stamp.nanosec)
             ranges.append(np.asarray(m.ranges, dtype=float))
             layout.add((round(float(m.angle_min), 6), round(float(m.angle_increment), 7)))
@@ -150,19 +222,29 @@ def read_bag(
             max_range = max(max_range, float(m.range_max))
         if not stamps:
             raise BagFormatError(f"{p}: topic {scan_conns[0].topic!r} holds no scans")
+        if widest[0] < 2:
+            raise BagFormatError(
+                f"{p}: scan {-widest[1]} of topic {scan_conns[0].topic!r}: the widest scan "
+                f"has {plural(widest[0], 'beam')}; a laser scan has at least 2"
+            )
         a0, inc = min(layout)
         interlaced = all(i == inc and 0 <= a - a0 < inc for a, i in layout)
         if len(layout) > 1 and not interlaced:
             raise BagFormatError(f"{p}: scans with different angle layouts {sorted(layout)}")
         odo_t, odo = [], []
-        for conn, _t, raw in reader.messages(connections=odom_conns):
+        for k, (conn, _t, raw) in enumerate(reader.messages(connections=odom_conns)):
             m = reader.deserialize(raw, conn.msgtype)
             odo_t.append(m.header.stamp.sec + 1e-9 * m.header.stamp.nanosec)
             pose = m.pose.pose
+            problem = _pose_problem(pose.position, pose.orientation)
+            if problem is not None:
+                raise BagFormatError(
+                    f"{p}: odometry message {k} of topic {conn.topic!r}: {problem}"
+                )
             odo.append((pose.position.x, pose.position.y, _yaw(pose.orientation)))
         if not odo_t:
             raise BagFormatError(f"{p}: topic {odom_conns[0].topic!r} holds no odometry")
-        offset = _laser_offset(reader)
+        offset = _laser_offset(reader, p)
     finally:
         reader.close()
 
@@ -172,8 +254,9 @@ def read_bag(
         rr[k, : len(r)] = r  # shorter scans of the same layout: missing beams are invalid
     converted = abs(inc - np.pi / (n - 1)) < 1e-6
     angles = flaser_angles(n) if beams == "carmen" and converted else a0 + inc * np.arange(n)
+    stated = max_range
     if max_range_override is None:
-        max_range, _ = effective_max_range(rr, max_range, max_range)
+        max_range, _ = effective_max_range(rr, stated, stated)
     else:
         max_range = float(max_range_override)
     t = np.asarray(stamps)
@@ -201,19 +284,26 @@ def read_bag(
         laser_offset=offset,
         angle_offsets=(np.asarray(starts)[order] - a0) if len(layout) > 1 else None,
         laser_offset_source="tf_static",
+        stated_max_range=stated,
     )
 
 
-def _laser_offset(reader) -> NDArray[np.float64]:
+def _laser_offset(reader, path: Path) -> NDArray[np.float64]:
     """``base_link`` → laser from ``/tf_static`` (zero when the bag has none)."""
     for conn in reader.connections:
         if conn.msgtype != "tf2_msgs/msg/TFMessage" or "static" not in conn.topic:
             continue
-        for c, _t, raw in reader.messages(connections=[conn]):
+        for k, (c, _t, raw) in enumerate(reader.messages(connections=[conn])):
             for tr in reader.deserialize(raw, c.msgtype).transforms:
                 if "laser" in tr.child_frame_id:
-                    v = tr.transform.translation
-                    return np.array([v.x, v.y, _yaw(tr.transform.rotation)])
+                    v, q = tr.transform.translation, tr.transform.rotation
+                    problem = _pose_problem(v, q)
+                    if problem is not None:
+                        raise BagFormatError(
+                            f"{path}: message {k} of topic {conn.topic!r}, the laser mount "
+                            f"{tr.child_frame_id!r}: {problem}"
+                        )
+                    return np.array([v.x, v.y, _yaw(q)])
     return np.zeros(3)
 
 

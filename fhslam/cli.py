@@ -1,7 +1,10 @@
 """The ``fhslam`` command (the contract is in DESIGN.md).
 
 Bad input — a missing or malformed file, an unknown world — ends with one line on stderr,
-``fhslam: error: <file>:<line>: <what>``, and exit status 2; never a traceback.
+``fhslam: error: <file>:<line>: <what>``, and exit status 2; never a traceback. Every command
+checks that it can write each of its outputs before it reads or computes anything, and writes
+them all or none (:mod:`fhslam.io.files`). Ctrl-C ends a command with one line,
+``fhslam: interrupted; ...`` naming what was not written, and exit status 130.
 """
 
 from __future__ import annotations
@@ -14,12 +17,23 @@ from contextlib import contextmanager
 from pathlib import Path
 
 EXIT_BAD_INPUT = 2
+EXIT_INTERRUPTED = 130
+"""Exit status after Ctrl-C (SIGINT): 128 + 2, as a shell reports it."""
 
 SLAM_METHODS = ("fht", "graph", "classical", "ekf", "odometry")
 """The ``--method`` choices of ``slam`` and ``bench`` (:data:`fhslam.pipeline.METHODS`)."""
 
 MAX_LAPS = 100
 """Largest ``simulate --laps``: a hundred laps of the paper world are 92,000 scans."""
+
+MAX_BENCH_SCANS = 1000
+"""Largest ``bench --scans`` without ``--log``: scans per held-out world (each has 300-400)."""
+
+MAX_REPEATS = 1000
+"""Largest ``bench --repeats``."""
+
+SIMULATE_PROGRESS_SCANS = 5000
+"""``simulate`` shows progress bars for routes of more scans than this (about a second)."""
 
 PROFILE_TOP = 25
 """Functions listed by ``--profile``."""
@@ -33,9 +47,9 @@ PROFILE_HELP = (
 def _simulate(args: argparse.Namespace) -> None:
     from fhslam.errors import InputError
     from fhslam.io import write_carmen, write_trajectory
-    from fhslam.io.files import check_outputs
+    from fhslam.io.files import check_outputs, output_batch
     from fhslam.sim import OdometryNoise, load_world, simulate
-    from fhslam.sim.simulate import is_closed_route
+    from fhslam.sim.simulate import check_scan_limit, is_closed_route
     from fhslam.sim.world import BUILTIN_WORLDS
 
     if args.seed < 0:
@@ -54,15 +68,18 @@ def _simulate(args: argparse.Namespace) -> None:
             f"{world.route[0].tolist()} to {world.route[-1].tolist()}); only a closed route "
             "can be driven more than once"
         )
+    n = check_scan_limit(world, args.laps, source=None if builtin else str(args.world))
     noise = OdometryNoise.drifting() if args.odometry == "drifting" else OdometryNoise()
-    log = simulate(world, seed=args.seed, odometry=noise, laps=args.laps)
-    write_carmen(log, args.log)
-    write_trajectory(
-        args.truth,
-        log.timestamps,
-        log.truth,
-        header=f"ground truth of {world.name!r}, seed {args.seed}: timestamp x y theta",
-    )
+    progress = not args.quiet and n > SIMULATE_PROGRESS_SCANS
+    log = simulate(world, seed=args.seed, odometry=noise, laps=args.laps, progress=progress)
+    with output_batch():  # both files or neither
+        write_carmen(log, args.log)
+        write_trajectory(
+            args.truth,
+            log.timestamps,
+            log.truth,
+            header=f"ground truth of {world.name!r}, seed {args.seed}: timestamp x y theta",
+        )
     print(f"wrote {len(log)} scans to {args.log} and the true poses to {args.truth}")
 
 
@@ -165,12 +182,15 @@ def _evaluate(args: argparse.Namespace) -> None:
         given, missing = ("--world", "--map") if args.map is None else ("--map", "--world")
         raise InputError(f"{given} needs {missing}: the map is compared with the world's walls")
     delta = 1 if args.delta is None else args.delta
+    max_diff = 0.01 if args.max_diff is None else args.max_diff
+    if delta > 1:
+        _check_delta(args.trajectory, args.truth, max_diff, delta)
     rep = evaluate_truth(
         args.trajectory,
         args.truth,
         args.world,
         args.map,
-        max_diff=0.01 if args.max_diff is None else args.max_diff,
+        max_diff=max_diff,
         delta=delta,
         align=args.align,
     )
@@ -197,13 +217,32 @@ def _evaluate(args: argparse.Namespace) -> None:
         )
 
 
+def _check_delta(trajectory: Path, truth: Path, max_diff: float, delta: int) -> None:
+    """Refuse an RPE ``--delta`` that is not below the number of matched poses (the pairs it
+    needs do not exist); fewer than 2 matched poses are left to ``evaluate_truth``'s error."""
+    from fhslam.errors import InputError
+    from fhslam.io import read_trajectory
+    from fhslam.metrics import associate
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # evaluate_truth reads them again and warns then
+        t_est, _ = read_trajectory(trajectory)
+        t_ref, _ = read_trajectory(truth)
+    n = len(associate(t_est, t_ref, max_diff=max_diff)[0])
+    if n >= 2 and delta >= n:
+        raise InputError(
+            f"--delta {delta}: the RPE pairs poses {delta} frames apart, but only {n} poses of "
+            f"{trajectory} match {truth}; give a --delta from 1 to {n - 1}"
+        )
+
+
 def _reproduce(args: argparse.Namespace) -> None:
     import matplotlib
 
     matplotlib.use("Agg")
     from fhslam.figures import reproduce
 
-    for path in reproduce(args.out):
+    for path in reproduce(args.out, what=f"--out {args.out}"):
         print(path)
 
 
@@ -232,7 +271,7 @@ def _slam(args: argparse.Namespace) -> None:
     import fhslam.datasets  # noqa: F401  (imported before --profile starts: not what it shows)
     from fhslam.errors import InputError, InputWarning
     from fhslam.io import write_graph, write_map, write_trajectory
-    from fhslam.io.files import check_outputs
+    from fhslam.io.files import check_outputs, output_batch
     from fhslam.pipeline import keyframe_graph, make_backend, run_backend, run_slam
 
     if args.graph is not None and args.method != "graph":
@@ -261,23 +300,25 @@ def _slam(args: argparse.Namespace) -> None:
             backend = make_backend(args.method)
             result = run_backend(backend, log, progress, desc=f"{args.method} {log.name}")
             graph = keyframe_graph(backend, log)
-        # Everything is computed before anything is written: bad input leaves no half files.
-        write_trajectory(
-            args.trajectory,
-            result.timestamps,
-            result.poses,
-            header=f"fhslam slam --method {args.method} {args.log}: timestamp x y theta",
-        )
-        wrote = [f"{len(result.poses)} poses to {args.trajectory}"]
-        if args.map is not None:
-            write_map(args.map, result.map)
-            wrote.append(f"{len(result.map)} map lines to {args.map}")
-        if graph is not None:
-            write_graph(args.graph, graph)
-            wrote.append(
-                f"{len(graph)} keyframes and {len(graph.active)} loop closures "
-                f"({graph.n_active} active) to {args.graph}"
+        # Everything is computed before anything is written, and the files are renamed into
+        # place together: bad input or a failed write leaves none of them.
+        with output_batch():
+            write_trajectory(
+                args.trajectory,
+                result.timestamps,
+                result.poses,
+                header=f"fhslam slam --method {args.method} {args.log}: timestamp x y theta",
             )
+            wrote = [f"{len(result.poses)} poses to {args.trajectory}"]
+            if args.map is not None:
+                write_map(args.map, result.map)
+                wrote.append(f"{len(result.map)} map lines to {args.map}")
+            if graph is not None:
+                write_graph(args.graph, graph)
+                wrote.append(
+                    f"{len(graph)} keyframes and {len(graph.active)} loop closures "
+                    f"({graph.n_active} active) to {args.graph}"
+                )
         print("wrote " + ", ".join(wrote[:-1]) + (" and " if len(wrote) > 1 else "") + wrote[-1])
 
 
@@ -290,6 +331,13 @@ def _bench(args: argparse.Namespace) -> None:
     for opt, value in (("--scans", args.scans), ("--repeats", args.repeats)):
         if value is not None and value < 1:
             raise InputError(f"{opt} must be a positive number, got {value}")
+    if args.repeats is not None and args.repeats > MAX_REPEATS:
+        raise InputError(f"--repeats must be between 1 and {MAX_REPEATS}, got {args.repeats}")
+    if args.log is None and args.scans is not None and args.scans > MAX_BENCH_SCANS:
+        raise InputError(
+            f"--scans must be between 1 and {MAX_BENCH_SCANS} scans per held-out world, got "
+            f"{args.scans}"
+        )
     if args.log is None:
         given = [
             opt
@@ -343,6 +391,28 @@ def _positive(unit: str):
 _positive_metres = _positive("metres")
 
 
+def _non_negative_seconds(text: str) -> float:
+    """An argparse type: a finite number of seconds, 0 or more."""
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"not a number: {text!r}") from None
+    if not (value >= 0 and value < float("inf")):
+        raise argparse.ArgumentTypeError(f"must be a finite number of seconds >= 0, got {text}")
+    return value
+
+
+def _positive_int(text: str) -> int:
+    """An argparse type: a whole number 1 or more."""
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"not a whole number: {text!r}") from None
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"must be a whole number >= 1, got {text}")
+    return value
+
+
 def _log_arguments(p: argparse.ArgumentParser) -> None:
     """The options of every command that reads a laser log (``slam``, ``info``)."""
     p.add_argument(
@@ -386,6 +456,11 @@ def build_parser() -> argparse.ArgumentParser:
         type=int,
         default=1,
         help=f"drive a closed route this many times (1 to {MAX_LAPS})",
+    )
+    p.add_argument(
+        "--quiet",
+        action="store_true",
+        help=f"no progress bars (shown for routes of more than {SIMULATE_PROGRESS_SCANS} scans)",
     )
     p.set_defaults(run=_simulate)
 
@@ -451,13 +526,16 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--map", type=Path, help="map JSON of the run (needs --world and --truth)")
     p.add_argument(
         "--max-diff",
-        type=float,
+        type=_non_negative_seconds,
         default=None,
         help="largest timestamp difference of matched poses, s (default 0.01 with --truth, "
         "0.001 with --relations)",
     )
     p.add_argument(
-        "--delta", type=int, default=None, help="RPE frame distance (default 1; --truth only)"
+        "--delta",
+        type=_positive_int,
+        default=None,
+        help="RPE frame distance, fewer than the matched poses (default 1; --truth only)",
     )
     p.add_argument(
         "--align", action="store_true", help="SE(2)-align the estimate before ATE (--truth only)"
@@ -593,6 +671,7 @@ def build_parser() -> argparse.ArgumentParser:
 
 def _run_notebooks(args: argparse.Namespace) -> None:
     from fhslam.errors import InputError
+    from fhslam.io.files import check_folder_writable
     from fhslam.workbook import notebooks_in, pair, run_notebook
 
     found = notebooks_in(args.notebooks)
@@ -600,11 +679,15 @@ def _run_notebooks(args: argparse.Namespace) -> None:
     missing = [n for n in args.only if not any(p.name.startswith(n) for p in found)]
     if missing:
         raise InputError(f"{args.notebooks}: no notebook starts with {', '.join(missing)}")
+    # the notebooks and their .py are written back there: checked before minutes of running
+    check_folder_writable(args.notebooks, f"--notebooks {args.notebooks}")
     for path in chosen:
+        args.in_progress = path  # named by main() if interrupted: left as it was
         if args.pair_only:
             print(f"{pair(path)}: written")
         else:
             print(run_notebook(path, timeout=args.timeout), flush=True)
+    args.in_progress = None
 
 
 def _sweep(args: argparse.Namespace) -> None:
@@ -612,18 +695,19 @@ def _sweep(args: argparse.Namespace) -> None:
     from fhslam.experiments import compare
     from fhslam.io.files import check_outputs
     from fhslam.sim import load_world
+    from fhslam.sim.simulate import check_scan_limit
+    from fhslam.sim.world import BUILTIN_WORLDS
 
     if not 1 <= args.seeds <= 1000:
         raise InputError(f"--seeds must be between 1 and 1000, got {args.seeds}")
     if args.jobs == 0:
         raise InputError("--jobs must not be 0 (-1: all cores)")
-    load_world(args.world)  # a bad world is an error before any worker starts
-    if args.out is not None:  # and an output that cannot be written, before the hours of work
-        check_outputs({"--out": args.out}, {"the world file": args.world})
-        if args.out.is_dir():
-            raise InputError(f"--out {args.out}: is a directory; give a file name")
-        if not args.out.parent.is_dir():
-            raise InputError(f"--out {args.out}: no such folder {args.out.parent}")
+    world = load_world(args.world)  # a bad world is an error before any worker starts
+    builtin = args.world in BUILTIN_WORLDS or args.world.startswith("random:")
+    check_scan_limit(world, source=None if builtin else args.world)
+    # and an output that cannot be written (a directory, no such folder, a read-only one),
+    # before the hours of work
+    check_outputs({"--out": args.out}, {"the world file": None if builtin else args.world})
     rows = compare.slam_sweep(
         world=args.world,
         seeds=range(args.seeds),
@@ -655,20 +739,65 @@ def _show_warning(message, category, filename, lineno, file=None, line=None) -> 
     print(f"fhslam: warning: {text}", file=sys.stderr)
 
 
+_OUTPUTS = {
+    "simulate": ("--log", "--truth"),
+    "slam": ("--trajectory", "--map", "--graph"),
+    "sweep": ("--out",),
+    "reproduce": ("--out",),
+    "student-copy": ("out",),
+}
+"""Each command's output options (``out``: a positional argument), for the interrupt line."""
+
+
+def _interrupted(args: argparse.Namespace) -> str:
+    """The line printed after Ctrl-C: what was not written (outputs appear all or none)."""
+    if args.command == "run-notebooks":
+        path = getattr(args, "in_progress", None)
+        return f"interrupted; {path} left as it was" if path else "interrupted"
+    given = [
+        f"{opt} {value}" if opt.startswith("-") else str(value)
+        for opt in _OUTPUTS.get(args.command, ())
+        if (value := getattr(args, opt.lstrip("-").replace("-", "_"))) is not None
+    ]
+    return f"interrupted; nothing written to {', '.join(given)}" if given else "interrupted"
+
+
 def main(argv: list[str] | None = None) -> int:
     from fhslam.errors import InputError
+    from fhslam.io.files import interrupted_before_output, watch_interrupts
 
     args = build_parser().parse_args(argv)
     try:
-        with warnings.catch_warnings():
+        with watch_interrupts(), warnings.catch_warnings():
             # implausible but readable input: one line each, the input named
             warnings.showwarning = _show_warning
             args.run(args)
+            if interrupted_before_output():  # Ctrl-C swallowed somewhere (watch_interrupts)
+                raise KeyboardInterrupt
     except InputError as e:  # bad input; anything else is a bug and keeps its traceback
         message = " ".join(str(e).split())  # one line, whatever the message
         print(f"fhslam: error: {message}", file=sys.stderr)
         return EXIT_BAD_INPUT
+    except BaseException as e:  # Ctrl-C: the outputs' temporary files are already removed
+        if not _after_interrupt(e):
+            raise
+        sys.stdout.flush()
+        print(f"fhslam: {_interrupted(args)}", file=sys.stderr)
+        return EXIT_INTERRUPTED
     return 0
+
+
+def _after_interrupt(e: BaseException) -> bool:
+    """Whether ``e`` is Ctrl-C's KeyboardInterrupt or was raised because of one: landing in
+    C code that called back into Python (numba loading a compiled function from its cache),
+    it comes out as a SystemError whose cause is the KeyboardInterrupt."""
+    seen: set[int] = set()
+    while e is not None and id(e) not in seen:
+        if isinstance(e, KeyboardInterrupt):
+            return True
+        seen.add(id(e))
+        e = e.__cause__ or e.__context__
+    return False
 
 
 if __name__ == "__main__":

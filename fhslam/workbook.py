@@ -23,7 +23,7 @@ from os import PathLike
 from pathlib import Path
 
 from fhslam.errors import InputError
-from fhslam.io.files import atomic_output
+from fhslam.io.files import atomic_output, output_batch, output_folder, reading
 
 __all__ = [
     "FORMATS",
@@ -54,6 +54,8 @@ _JUPYTEXT = {
 def notebooks_in(folder: str | PathLike[str]) -> list[Path]:
     """The notebooks ``*.ipynb`` of ``folder``, sorted by name (their teaching order)."""
     src = Path(folder)
+    if src.exists() and not src.is_dir():
+        raise InputError(f"{src}: is a file, not a folder of notebooks")
     if not src.is_dir():
         raise InputError(f"{src}: no such folder of notebooks")
     found = sorted(src.glob("*.ipynb"))
@@ -89,10 +91,11 @@ def _write(nb, path: Path) -> None:
     import nbformat
 
     text = paired_text(nb)  # sets the pairing in nb's metadata first
-    with atomic_output(path) as f:
-        nbformat.write(nb, f)
-    with atomic_output(paired_path(path)) as f:
-        f.write(text)
+    with output_batch():  # the notebook and its .py together, or neither
+        with atomic_output(path) as f:
+            nbformat.write(nb, f)
+        with atomic_output(paired_path(path)) as f:
+            f.write(text)
 
 
 def pair(path: str | PathLike[str]) -> Path:
@@ -134,36 +137,64 @@ def _cell_seconds(cell) -> float:
 
 def run_notebook(path: str | PathLike[str], timeout: float = 600.0) -> NotebookRun:
     """Execute notebook ``path`` in a fresh ``python3`` kernel, in its own folder, and write it
-    back with the new outputs and its paired ``.py``. A cell that raises stops the run: the
-    error is an :class:`~fhslam.errors.InputError` naming the notebook and the cell, and the
-    file is left as it was. ``timeout`` is per cell, in seconds."""
+    back with the new outputs and its paired ``.py``. A cell that raises (or kills the
+    kernel) stops the run: the error is an :class:`~fhslam.errors.InputError` naming the
+    notebook and the cell, and the file is left as it was. ``timeout`` is per cell, in
+    seconds. The kernel's own log (its stderr: connection warnings, and its tracebacks when
+    it is shut down mid-cell) is kept out of the terminal.
+
+    Raises
+    ------
+    InputError
+        For an unreadable notebook, a cell that fails or times out, a kernel that dies.
+    KeyboardInterrupt
+        On Ctrl-C (SIGINT; also SIGTERM) while it runs: nbclient shuts the kernel down, and
+        whatever that raises inside nbclient is reported as the interrupt it is.
+    """
+    import subprocess
+
     from nbclient import NotebookClient
-    from nbclient.exceptions import CellExecutionError, CellTimeoutError
+    from nbclient.exceptions import CellExecutionError, CellTimeoutError, DeadKernelError
 
     p = Path(path)
     nb = _read(p)
+    running: list[int] = []
     client = NotebookClient(
         nb,
         timeout=timeout,
         kernel_name="python3",
         resources={"metadata": {"path": str(p.parent.resolve())}},
         record_timing=True,
+        on_cell_start=lambda cell, cell_index: running.append(cell_index),
     )
     t0 = time.perf_counter()
     try:
-        client.execute()
-    except (CellExecutionError, CellTimeoutError) as e:
-        failed = next(
-            (
-                i
-                for i, c in enumerate(nb.cells)
-                if any(o.get("output_type") == "error" for o in c.get("outputs", []))
-            ),
-            None,
-        )
-        where = f"cell {failed}" if failed is not None else "a cell"
-        last = str(e).strip().splitlines()[-1] if str(e).strip() else type(e).__name__
-        raise InputError(f"{p}: {where} failed: {last}") from None
+        client.execute(stderr=subprocess.DEVNULL)
+    except BaseException as e:
+        # nbclient handles SIGINT itself, by shutting the kernel down: the cell then fails
+        # with DeadKernelError and the cleanup with an AssertionError. Its handler leaves this
+        # attribute behind (nbclient 0.5-0.10).
+        if getattr(client, "_async_cleanup_kernel_future", None) is not None:
+            raise KeyboardInterrupt from None
+        if isinstance(e, CellExecutionError | CellTimeoutError):
+            failed = next(
+                (
+                    i
+                    for i, c in enumerate(nb.cells)
+                    if any(o.get("output_type") == "error" for o in c.get("outputs", []))
+                ),
+                None,
+            )
+            where = f"cell {failed}" if failed is not None else "a cell"
+            last = str(e).strip().splitlines()[-1] if str(e).strip() else type(e).__name__
+            raise InputError(f"{p}: {where} failed: {last}") from None
+        if isinstance(e, DeadKernelError):
+            where = f"cell {running[-1]}" if running else "starting the kernel"
+            raise InputError(
+                f"{p}: the kernel died in {where} (its process ended: a crash, os._exit, out "
+                "of memory)"
+            ) from None
+        raise
     seconds = time.perf_counter() - t0
     times = [(_cell_seconds(c), i) for i, c in enumerate(nb.cells) if c.cell_type == "code"]
     slow, index = max(times, default=(0.0, -1))
@@ -179,18 +210,28 @@ def student_copy(source: str | PathLike[str], out: str | PathLike[str]) -> list[
     """Write every notebook of folder ``source`` to folder ``out`` without its solution cells
     (cells tagged ``solution``) and without outputs; returns ``(path, solutions removed)`` per
     notebook. ``out`` must not be ``source``. The copies are not paired with a ``.py``; the
-    results the notebooks load (folder ``results``) are copied with them."""
-    import shutil
+    results the notebooks load (folder ``results``) are copied with them.
 
+    Every notebook is read and checked before anything is written, and the copies appear
+    together once all are written, or none (:func:`~fhslam.io.files.output_batch`): a broken
+    notebook, an ``out`` that is a file or cannot be written, or Ctrl-C leaves no copy (and
+    no folder created for it).
+
+    Raises
+    ------
+    InputError
+        Naming the folder or the notebook that is wrong.
+    """
     import nbformat
 
     src, dst = Path(source), Path(out)
     notebooks = notebooks_in(src)
     if dst.exists() and dst.resolve() == src.resolve():
         raise InputError(f"{dst}: is the source folder; the student copy must go elsewhere")
-    dst.mkdir(parents=True, exist_ok=True)
-    written = []
-    for path in notebooks:
+    if dst.exists() and not dst.is_dir():
+        raise InputError(f"{dst}: is a file, not a folder; give a folder for the student copy")
+    copies = []
+    for path in notebooks:  # every notebook read and stripped first: a broken one stops all
         nb = _read(path)
         kept = [c for c in nb.cells if not _is_solution(c)]
         removed = len(nb.cells) - len(kept)
@@ -199,9 +240,27 @@ def student_copy(source: str | PathLike[str], out: str | PathLike[str]) -> list[
         for c in nb.cells:
             if c.cell_type == "code":
                 c.outputs, c.execution_count = [], None
-        with atomic_output(dst / path.name) as f:
-            nbformat.write(nb, f)
-        written.append((dst / path.name, removed))
-    if (src / RESULTS).is_dir():
-        shutil.copytree(src / RESULTS, dst / RESULTS, dirs_exist_ok=True)
-    return written
+        try:
+            text = nbformat.writes(nb)
+        except Exception as e:  # nbformat raises several types for an invalid notebook
+            raise InputError(f"{path}: not a valid notebook ({e})") from None
+        copies.append((path.name, text if text.endswith("\n") else text + "\n", removed))
+    results = src / RESULTS
+    files = {}  # the results read before anything is written too (a few MB)
+    for p in sorted(results.rglob("*")) if results.is_dir() else []:
+        if p.is_file():
+            with reading(p):
+                files[p.relative_to(results)] = p.read_bytes()
+    with output_folder(dst, str(dst)), output_batch():
+        for name, text, _ in copies:
+            with atomic_output(dst / name) as f:
+                f.write(text)
+        for relative, data in files.items():
+            target = dst / RESULTS / relative
+            try:
+                target.parent.mkdir(parents=True, exist_ok=True)
+            except OSError as e:
+                raise InputError(f"{target.parent}: cannot create ({e.strerror or e})") from None
+            with atomic_output(target, "wb") as f:
+                f.write(data)
+    return [(dst / name, removed) for name, _, removed in copies]

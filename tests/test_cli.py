@@ -591,3 +591,142 @@ def test_simulate_bad_options_are_one_line_exit_2(tmp_path, options, message):
     assert len(r.stderr.splitlines()) == 1 and r.stderr.startswith("fhslam: error: ")
     assert message in r.stderr
     assert list(tmp_path.iterdir()) == []
+
+
+def usage_error(argv: list[str], capsys) -> str:
+    """stderr of a command that argparse refuses (exit status 2), in this process."""
+    with pytest.raises(SystemExit) as e:
+        main(argv)
+    assert e.value.code == 2
+    err = capsys.readouterr().err
+    assert "Traceback" not in err
+    return err
+
+
+@pytest.mark.parametrize(
+    ("option", "value", "message"),
+    [
+        # issue 13: each was a ValueError traceback from metrics/trajectory.py, or (inf)
+        # accepted without a word
+        ("--delta", "0", "argument --delta: must be a whole number >= 1, got 0"),
+        ("--delta", "-3", "argument --delta: must be a whole number >= 1, got -3"),
+        ("--delta", "2.5", "argument --delta: not a whole number: '2.5'"),
+        ("--max-diff", "-1", "argument --max-diff: must be a finite number of seconds >= 0"),
+        ("--max-diff", "nan", "argument --max-diff: must be a finite number of seconds >= 0"),
+        ("--max-diff", "inf", "argument --max-diff: must be a finite number of seconds >= 0"),
+        ("--max-diff", "soon", "argument --max-diff: not a number: 'soon'"),
+    ],
+)
+def test_evaluate_bad_delta_and_max_diff_are_usage_errors(truth_file, capsys, option, value,
+                                                          message):  # fmt: skip
+    err = usage_error(["evaluate", str(truth_file), "--truth", str(truth_file), option, value],
+                      capsys)  # fmt: skip
+    assert err.splitlines()[-1] == f"fhslam evaluate: error: {message}" or message in err
+
+
+def test_evaluate_delta_beyond_the_matched_poses_is_one_line(truth_file, capsys):
+    argv = ["evaluate", str(truth_file), "--truth", str(truth_file)]
+    for delta in ("100000", "916"):
+        assert main([*argv, "--delta", delta]) == 2
+        assert capsys.readouterr().err == (
+            f"fhslam: error: --delta {delta}: the RPE pairs poses {delta} frames apart, but "
+            f"only 916 poses of {truth_file} match {truth_file}; give a --delta from 1 to 915\n"
+        )
+    assert main([*argv, "--delta", "915", "--max-diff", "0"]) == 0
+    assert "RPE over 1 pairs 915 frame(s) apart" in capsys.readouterr().out
+
+
+@pytest.mark.parametrize(
+    ("argv", "message"),
+    [
+        # issue 13: `ValueError: Maximum allowed size exceeded` from np.linspace
+        (["--scans", "99999999999999999999"], "--scans must be between 1 and 1000 scans per"),
+        (["--scans", "1001"], "--scans must be between 1 and 1000 scans per held-out world"),
+        (["--repeats", "1001"], "--repeats must be between 1 and 1000, got 1001"),
+    ],
+)
+def test_bench_huge_counts_are_one_line_exit_2(argv, message, capsys):
+    assert main(["bench", *argv]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("fhslam: error: ") and message in err and err.count("\n") == 1
+
+
+def test_bench_on_a_log_takes_more_scans_than_it_has(short_clf, capsys):
+    # with --log, --scans only cuts the log: a count beyond it is all of it
+    assert main(["bench", "--log", str(short_clf), "--scans", "99999999999999999999",
+                 "--method", "odometry", "--quiet"]) == 0  # fmt: skip
+    assert "short (odometry): 60 scans" in capsys.readouterr().out
+
+
+def test_slam_writes_its_outputs_all_or_none(short_clf, tmp_path, monkeypatch, capsys):
+    """issue 13: a failure writing a later output (the map) left the earlier one (the
+    trajectory) behind; now the outputs are renamed into place together, or not at all."""
+    import fhslam.io
+    from fhslam.errors import InputError
+
+    traj, old = tmp_path / "t.txt", "an old trajectory\n"
+    traj.write_text(old)
+
+    def fail(path, lines):
+        raise InputError(f"{path}: cannot write (disk full)")
+
+    monkeypatch.setattr(fhslam.io, "write_map", fail)
+    argv = ["slam", str(short_clf), "--method", "odometry", "--trajectory", str(traj)]
+    assert main([*argv, "--map", str(tmp_path / "m.json"), "--quiet"]) == 2
+    assert "m.json: cannot write (disk full)" in capsys.readouterr().err
+    assert traj.read_text() == old  # the old file stands, the new one never appeared
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["t.txt"]
+
+
+def test_simulate_writes_its_outputs_all_or_none(tmp_path, monkeypatch, capsys):
+    import fhslam.io
+    from fhslam.errors import InputError
+
+    def fail(path, *args, **kwargs):
+        raise InputError(f"{path}: cannot write (disk full)")
+
+    monkeypatch.setattr(fhslam.io, "write_trajectory", fail)
+    argv = ["simulate", "hall", "--log", str(tmp_path / "h.clf"), "--truth", str(tmp_path / "t")]
+    assert main(argv) == 2
+    assert capsys.readouterr().err == f"fhslam: error: {tmp_path / 't'}: cannot write (disk full)\n"
+    assert list(tmp_path.iterdir()) == []  # the log, complete by then, was not renamed either
+
+
+def _corridor(tmp_path, length: float):
+    """A straight corridor ``length`` metres long (4 m wide), its route along it."""
+    path = tmp_path / "long.json"
+    walls = [[0, 0, length, 0], [length, 0, length, 4], [length, 4, 0, 4], [0, 4, 0, 0]]
+    path.write_text(json.dumps({"name": "long", "walls": walls,
+                                "route": [[1, 2], [length - 1, 2]]}))  # fmt: skip
+    return path
+
+
+def test_simulate_refuses_a_route_beyond_the_scan_limit_before_any_work(tmp_path):
+    """issue 13: a world 100 km long ran for minutes without a word (1.25 million scans)."""
+    import time
+
+    world = _corridor(tmp_path, 1e5)
+    t0 = time.perf_counter()
+    r = run("simulate", str(world), "--log", str(tmp_path / "o.clf"), "--truth",
+            str(tmp_path / "o.txt"))  # fmt: skip
+    assert r.returncode == 2 and time.perf_counter() - t0 < 30
+    assert r.stderr == (
+        f"fhslam: error: world {world} ('long'): its route of 99,998 m is about 1,249,976 scans "
+        "at 0.4 m/s and 5 scans per second; the limit is 500,000 scans (nothing was simulated)\n"
+    )
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["long.json"]
+
+
+def test_simulate_shows_progress_on_a_long_route_unless_quiet(tmp_path):
+    world = _corridor(tmp_path, 500.0)  # about 6,200 scans: 1-2 s
+    args = [str(world), "--log", str(tmp_path / "o.clf"), "--truth", str(tmp_path / "o.txt")]
+    r = run("simulate", *args)
+    assert r.returncode == 0 and "Traceback" not in r.stderr
+    assert r.stdout.startswith("wrote 6225 scans to ")
+    bars = r.stderr.replace("\r", "\n")
+    assert "simulate long: driving: 100%" in bars and "6225/6225" in bars
+    assert "simulate long: laser: 100%" in bars
+    r = run("simulate", *args, "--quiet")
+    assert r.returncode == 0 and r.stderr == ""
+    r = run("simulate", "paper", "--log", str(tmp_path / "p.clf"), "--truth", str(tmp_path / "t"))
+    assert r.returncode == 0 and r.stderr == ""  # 916 scans: no bar

@@ -335,6 +335,69 @@ def test_load_world_malformed_files_name_file_and_field(tmp_path, content, match
         load_world(path)
 
 
+BOX = {"walls": [[0, 0, 6, 0], [6, 0, 6, 4], [6, 4, 0, 4], [0, 4, 0, 0]], "route": [[1, 1], [5, 1]]}
+
+
+@pytest.mark.parametrize(
+    ("changes", "message"),
+    [
+        # issue 13: `true` was read as 1, "1" as 1, null in 'start' as NaN ("not finite")
+        ({"walls": [*BOX["walls"][:3], [0, 4, 0, True]]},
+         "field 'walls' must be a list of [number, number, number, number] rows: row 3 holds "
+         "true, which is not a number"),
+        ({"route": [[1, 1], [5, False]]}, "field 'route' must be a list of [number, number] "
+         "rows: row 1 holds false, which is not a number"),
+        ({"route": [[1, 1], [5, "1"]]}, 'row 1 holds "1", which is not a number'),
+        ({"start": [1, 1, None]}, "field 'start' must be [x, y, theta] numbers: null is not a "
+         "number"),
+        ({"start": [True, 1, 0]}, "field 'start' must be [x, y, theta] numbers: true is not"),
+        ({"walls": 5}, "field 'walls' must be a list of [number, number, number, number] rows, "
+         "got 5"),
+        ({"walls": {"a": 1}}, "field 'walls' must be a list of"),
+    ],
+)  # fmt: skip
+def test_a_world_coordinate_must_be_a_json_number(tmp_path, changes, message):
+    path = tmp_path / "w.json"
+    path.write_text(json.dumps({**BOX, **changes}))
+    with pytest.raises(WorldFormatError) as e:
+        load_world(path)
+    assert str(e.value).startswith(f"{path}: field ") and message in str(e.value)
+
+
+def test_a_world_nested_too_deeply_is_a_format_error(tmp_path):
+    # issue 13: 100,000 nested '[' was a RecursionError from the json module
+    path = tmp_path / "deep.json"
+    path.write_text("[" * 100_000)
+    with pytest.raises(WorldFormatError, match=r"deep\.json: not a world: its JSON is nested too"):
+        load_world(path)
+
+
+def test_an_unknown_world_key_is_ignored_with_one_warning(tmp_path):
+    """issue 13: a misspelled key ("strat") was ignored without a word; now it is still
+    ignored (the world is well defined without it) but named, with the keys a world has."""
+    from fhslam.errors import InputWarning
+
+    path = tmp_path / "w.json"
+    path.write_text(json.dumps({**BOX, "strat": [1, 1, 0.5]}))
+    with pytest.warns(InputWarning) as caught:
+        w = load_world(path)
+    assert [str(c.message) for c in caught] == [
+        f"{path}: unknown key 'strat' ignored; a world has 'name', 'walls', 'route', 'start'"
+    ]
+    assert w.start.tolist() == [1.0, 1.0, 0.0]  # the default start, not the misspelled one
+    path.write_text(json.dumps({**BOX, "Name": "x", "comment": "mine"}))
+    with pytest.warns(InputWarning, match="unknown keys 'Name', 'comment' ignored"):
+        load_world(path)
+
+
+def test_a_world_built_from_arrays_still_takes_numpy_numbers():
+    w = World(name="np", walls=SQUARE.astype(np.float32), route=np.array([[0, 0], [1, 0]]),
+              start=np.array([0, 0, 0.1]))  # fmt: skip
+    assert w.walls.dtype == np.float64 and w.start.tolist() == [0.0, 0.0, 0.1]
+    with pytest.raises(WorldFormatError, match="row 0 holds true"):
+        World(name="b", walls=np.array([[True, False, True, True]]), route=[[0, 0], [1, 0]])
+
+
 # ---------------------------------------------------------------------------- drifting odometry
 
 # Two beams: the laser stream is independent of the odometry stream, so the odometry (and
@@ -587,3 +650,52 @@ def test_degrade_works_without_truth_or_hits(paper_log):
 def test_degrade_rejects_bad_arguments(paper_log, kwargs, match):
     with pytest.raises(ValueError, match=match):
         degrade(paper_log, **kwargs)
+
+
+# ------------------------------------------------------------------- how long a route is
+
+
+@pytest.mark.parametrize("name", ["paper", "hall", "corridor", "random:0", "random:101"])
+def test_expected_scans_is_within_six_per_cent_of_the_drive(name):
+    from fhslam.sim.simulate import expected_scans
+
+    w = load_world(name)
+    for laps in (1, 3) if name != "paper" else (1,):
+        n = len(follow_route(w, laps=laps))
+        assert abs(expected_scans(w, laps=laps) - n) <= 0.06 * n, laps
+
+
+def test_a_route_beyond_the_scan_limit_is_refused_before_any_work(monkeypatch):
+    """issue 13: a 100 km route was simulated for minutes without a word; simulate() now
+    refuses a route of more than MAX_SCANS scans before driving it."""
+    import sys
+
+    from fhslam.errors import InputError
+
+    sim = sys.modules["fhslam.sim.simulate"]  # the module: fhslam.sim.simulate is the function
+
+    long = World(name="long", walls=np.array([[0, 0, 1e5, 0], [0, 4, 1e5, 4]]),
+                 route=np.array([[1, 2], [1e5 - 1, 2]]))  # fmt: skip
+    assert sim.expected_scans(long) == 1_249_976 > sim.MAX_SCANS
+    monkeypatch.setattr(sim, "follow_route", lambda *a, **k: pytest.fail("drove the route"))
+    with pytest.raises(InputError) as e:
+        simulate(long)
+    assert str(e.value) == (
+        "world 'long': its route of 99,998 m is about 1,249,976 scans at 0.4 m/s and 5 scans "
+        "per second; the limit is 500,000 scans (nothing was simulated)"
+    )
+    with pytest.raises(InputError, match=r"world w\.json \('long'\): its route of 99,998 m"):
+        sim.check_scan_limit(long, source="w.json")
+    # every built-in run, a hundred laps included, is far below the limit
+    assert sim.check_scan_limit(paper_world()) < 1000
+    assert 100 * sim.check_scan_limit(random_world(0), laps=1) < sim.MAX_SCANS / 10
+
+
+def test_progress_bars_do_not_change_the_simulation(capsys):
+    a = simulate(hall_world(), seed=2, progress=True)
+    err = capsys.readouterr().err.replace("\r", "\n")
+    assert "simulate hall: driving: 100%" in err and "simulate hall: laser: 100%" in err
+    b = simulate(hall_world(), seed=2)
+    np.testing.assert_array_equal(a.truth, b.truth)
+    np.testing.assert_array_equal(a.ranges, b.ranges)
+    assert capsys.readouterr().err == ""

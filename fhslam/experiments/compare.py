@@ -11,6 +11,7 @@ from __future__ import annotations
 import csv
 import os
 import time
+import warnings
 from collections.abc import Sequence
 from dataclasses import astuple, dataclass, fields, replace
 from pathlib import Path
@@ -19,7 +20,7 @@ import numpy as np
 from joblib import Parallel, delayed
 from tqdm.auto import tqdm
 
-from fhslam.errors import InputError
+from fhslam.errors import InputError, InputWarning
 from fhslam.io.files import atomic_output
 from fhslam.metrics import ate, map_error
 from fhslam.pipeline import METHODS, run_slam
@@ -56,9 +57,25 @@ class RunResult:
     n_map_lines: int
 
 
+def _thread_lock_for_tqdm() -> None:
+    """Give tqdm a plain thread lock in a worker process that has none yet: its default
+    lock is a multiprocessing one, a named semaphore that a worker killed after Ctrl-C never
+    releases (Python then warns of "leaked semaphore objects" at exit)."""
+    import threading
+
+    from tqdm import tqdm as std_tqdm
+
+    if not hasattr(std_tqdm, "_lock"):
+        std_tqdm.set_lock(threading.RLock())
+
+
 def one_run(world: str, level: str, seed: int, methods: Sequence[str]) -> list[RunResult]:
     """Simulate ``world`` with noise ``level`` and ``seed``; run every method on that log."""
-    log = simulate(load_world(world), seed=seed, odometry=noise_levels()[level])
+    _thread_lock_for_tqdm()
+    with warnings.catch_warnings():  # a world file's warnings: given once, before the sweep
+        warnings.simplefilter("ignore", InputWarning)
+        w = load_world(world)
+    log = simulate(w, seed=seed, odometry=noise_levels()[level])
     odo = ate(log.odometry, log.truth).rmse
     out = []
     for m in methods:

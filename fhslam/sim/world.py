@@ -6,7 +6,12 @@ A world is stored as JSON (see DESIGN.md)::
      "start": [x, y, theta]}
 
 in metres and radians; ``start`` is optional (default: the first waypoint, heading to the
-second). Built-in worlds: ``"paper"`` (:func:`paper_world`, the paper's 18.7 x 14.0 m office),
+second). Every coordinate must be a JSON number (``true``, ``"1"`` or ``null`` are refused, not
+read as 1, 1 or NaN); a key other than these four is read as a misspelling: the world is used
+without it and an :class:`~fhslam.errors.InputWarning` names the key and the known ones
+(:meth:`World.from_dict`).
+
+Built-in worlds: ``"paper"`` (:func:`paper_world`, the paper's 18.7 x 14.0 m office),
 ``"random:SEED"`` (:func:`random_world`, held-out worlds nothing was tuned on), and two small
 worlds with walls through the origin, ``"hall"`` (:func:`hall_world`) and ``"corridor"``
 (:func:`corridor_world`). :func:`transform_world` moves a world rigidly (to check that a
@@ -16,6 +21,7 @@ method does not depend on where the world frame lies).
 from __future__ import annotations
 
 import json
+import warnings
 from dataclasses import dataclass
 from os import PathLike
 from pathlib import Path
@@ -24,20 +30,65 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from fhslam.errors import InputError
+from fhslam.errors import InputError, InputWarning
 from fhslam.geometry import compose, segment_distances, transform_points
 from fhslam.io.files import input_path, reading
 from fhslam.io.mapfile import MAX_COORDINATE
 
 BUILTIN_WORLDS = ("paper", "hall", "corridor", "random:SEED")
 
+WORLD_KEYS = ("name", "walls", "route", "start")
+"""The keys of a world JSON object; any other is warned about and ignored."""
+
 
 class WorldFormatError(InputError):
     """A world definition (dict or JSON file) that is malformed; the message names the field."""
 
 
+def _json_text(value: Any) -> str:
+    """How ``value`` is spelled in JSON (``true``, ``null``, ``"1"``), for error messages."""
+    if isinstance(value, np.generic):
+        value = value.item()
+    try:
+        return json.dumps(value)[:40]
+    except (TypeError, ValueError):
+        return repr(value)[:40]
+
+
+def _not_a_number(value: Any) -> Any:
+    """The first entry of the nested lists ``value`` that is not a number (a bool, a string,
+    ``None``, ...), or ``None`` if every entry is one. NumPy number arrays pass at once."""
+    if isinstance(value, np.ndarray) and value.dtype.kind in "iuf":
+        return None
+    if isinstance(value, list | tuple | np.ndarray):
+        for v in value:
+            bad = _not_a_number(v)
+            if bad is not None:
+                return bad
+        return None
+    if isinstance(value, bool | np.bool_) or not isinstance(value, int | float | np.number):
+        return (value,)  # a tuple, so that a bad None is told from "all numbers"
+    return None
+
+
 def _array(value: Any, field: str, cols: int, min_rows: int) -> NDArray[np.float64]:
     """Validate a list of rows of ``cols`` finite numbers, at least ``min_rows`` rows."""
+    numeric = isinstance(value, np.ndarray) and value.dtype.kind in "iuf"
+    if not numeric and (
+        not isinstance(value, list | tuple | np.ndarray)
+        or (isinstance(value, np.ndarray) and value.ndim == 0)
+    ):
+        raise WorldFormatError(
+            f"field {field!r} must be a list of [{', '.join(['number'] * cols)}] rows, got "
+            f"{_json_text(value)}"
+        )
+    for i, row in enumerate([] if numeric else value):
+        bad = _not_a_number(row)
+        if bad is not None:
+            raise WorldFormatError(
+                f"field {field!r} must be a list of [{', '.join(['number'] * cols)}] rows: row "
+                f"{i} holds {_json_text(bad[0])}, which is not a number"
+            )
     try:
         a = np.array(value, dtype=float)  # a copy: the world makes it read-only
     except (TypeError, ValueError):
@@ -105,6 +156,12 @@ class World:
                 )
             start = np.array([*route[0], np.arctan2(d[1], d[0])])
         else:
+            bad = _not_a_number(self.start)
+            if bad is not None:
+                raise WorldFormatError(
+                    f"field 'start' must be [x, y, theta] numbers: {_json_text(bad[0])} is not a "
+                    "number"
+                )
             try:
                 start = np.asarray(self.start, dtype=float)
             except (TypeError, ValueError):
@@ -142,7 +199,12 @@ class World:
 
     @classmethod
     def from_dict(cls, d: dict[str, Any], source: str = "world") -> World:
-        """Build a world from the JSON structure; errors are prefixed with ``source``."""
+        """Build a world from the JSON structure; errors are prefixed with ``source``.
+
+        A key other than :data:`WORLD_KEYS` (a misspelled ``"strat"``, an editor's comment)
+        is ignored with one :class:`~fhslam.errors.InputWarning` naming it and the known
+        keys: the world is well defined without it, but what it was meant to say is not used.
+        """
         try:
             if not isinstance(d, dict):
                 raise WorldFormatError(
@@ -151,6 +213,15 @@ class World:
             missing = [k for k in ("walls", "route") if k not in d]
             if missing:
                 raise WorldFormatError(f"missing field {missing[0]!r}")
+            unknown = [str(k) for k in d if k not in WORLD_KEYS]
+            if unknown:
+                warnings.warn(
+                    f"{source}: unknown key{'s' if len(unknown) > 1 else ''} "
+                    f"{', '.join(repr(k) for k in unknown)} ignored; a world has "
+                    f"{', '.join(repr(k) for k in WORLD_KEYS)}",
+                    InputWarning,
+                    stacklevel=2,
+                )
             return cls(
                 name=d.get("name", Path(source).stem),
                 walls=d["walls"],
@@ -442,7 +513,14 @@ def load_world(name_or_path: str | PathLike[str]) -> World:
     MissingInputError
         For a path (ends in ``.json`` or contains a directory separator) that does not exist.
     WorldFormatError
-        For a file that is not valid JSON or has a malformed field; names the file and field.
+        For a file that is not valid JSON (also one nested too deeply to read) or has a
+        malformed field (a coordinate that is not a JSON number: ``true`` is not 1); names
+        the file and field.
+
+    Warns
+    -----
+    InputWarning
+        For a key other than ``name``, ``walls``, ``route`` and ``start`` (ignored).
     """
     text = str(name_or_path)
     if not isinstance(name_or_path, PathLike):
@@ -470,4 +548,9 @@ def load_world(name_or_path: str | PathLike[str]) -> World:
         data = json.loads(text)
     except (json.JSONDecodeError, UnicodeDecodeError) as e:
         raise WorldFormatError(f"{path}: not valid JSON ({e})") from None
+    except RecursionError:
+        raise WorldFormatError(
+            f"{path}: not a world: its JSON is nested too deeply to read (a world is an object "
+            "of lists of numbers, nested three deep)"
+        ) from None
     return World.from_dict(data, source=str(path))

@@ -25,11 +25,14 @@ def runs():
 
 
 #: How far a run now may be from the committed file's, in ATE (m): the line methods'
-#: results hold to far below a millimetre on any machine; the graph method's correlative
-#: search picks among near-equal cells, so its ATE on the paper world moves by up to about a
-#: centimetre under last-bit changes (README, "robustness"). A stale file is off by more: the
-#: graph rows of a file made before the tracker's last changes were 2-4 cm off.
-ATE_TOLERANCE = {"graph": 0.015}
+#: results hold to far below a millimetre on any machine. The graph method's does not on the
+#: paper world: along its long corridor only the odometry and faint cues place the robot, and
+#: a discrete choice that flips with the last bit (scan 33 of seed 0) grows to centimetres
+#: there. Seed 0 with the odometry multiplied by (1 + 1e-15 ε), 8 draws each (README,
+#: "robustness"): low 0.040-0.066 m, medium 0.051-0.080 m; the committed medium row (0.043 m,
+#: another machine) and this machine's unperturbed run (0.080 m) lie at the two ends. So a
+#: graph row is only checked to lie within that spread of a run now: 0.045 m.
+ATE_TOLERANCE = {"graph": 0.045}
 
 
 def test_a_sweep_file_reads_back_exactly(runs, tmp_path):
@@ -47,7 +50,8 @@ def test_a_sweep_file_reads_back_exactly(runs, tmp_path):
 def test_the_committed_sweep_is_what_this_code_computes(runs):
     """The file notebook 07 shows came from ``fhslam sweep --seeds 20``: its runs of seed 0
     at the low level, every method, and the graph method's at the medium level agree with a
-    run now (ATE to 0.5 mm, the graph method's to 1.5 cm; times are the machine's)."""
+    run now (ATE to 0.5 mm, the graph method's to 4.5 cm: see ``ATE_TOLERANCE``; times are the
+    machine's)."""
     committed = load_sweep(COMMITTED)
     assert len(committed) == 20 * 3 * 5
     assert {(r.seed, r.level) for r in committed} == {

@@ -240,9 +240,15 @@ class PoseGraph:
     def chi2(self, edges: ArrayLike) -> NDArray[np.float64]:
         """Squared Mahalanobis errors ``e^T Ω e`` of the given edges at the current poses."""
         k = np.asarray(edges, dtype=np.intp).reshape(-1)
-        i, j = np.array(self._i, dtype=np.intp)[k], np.array(self._j, dtype=np.intp)[k]
-        z = np.array(self._z).reshape(-1, 3)[k]
-        return _chi2(edge_errors(self.poses, i, j, z), np.array(self._info)[k])
+        # The given edges' rows only, and only their nodes' poses (the same numbers as
+        # indexing arrays of the whole graph, without building them at every call).
+        i = np.array([self._i[e] for e in k], dtype=np.intp)
+        j = np.array([self._j[e] for e in k], dtype=np.intp)
+        z = np.array([self._z[e] for e in k]).reshape(-1, 3)
+        info = np.array([self._info[e] for e in k]).reshape(-1, 3, 3)
+        nodes, ends = np.unique(np.concatenate([i, j]), return_inverse=True)
+        x = np.array([self._poses[n] for n in nodes]).reshape(-1, 3)
+        return _chi2(edge_errors(x, ends[: len(k)], ends[len(k) :], z), info)
 
     def set_measurement(self, e: int, z: ArrayLike) -> None:
         """Replace edge ``e``'s measurement."""

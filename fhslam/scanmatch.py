@@ -1,8 +1,8 @@
 """Correlative scan matching (Olson 2009): the pose of one point cloud in another's frame.
 
 The target cloud is rasterised into a *likelihood grid*: each cell holds
-``exp(-d² / 2σ²)`` of its distance ``d`` to the nearest target point (OpenCV's exact
-Euclidean distance transform). A candidate pose scores the mean likelihood of the query
+``exp(-d² / 2σ²)`` of its distance ``d`` to the nearest target point (an exact Euclidean
+distance transform, compiled). A candidate pose scores the mean likelihood of the query
 points it places in the grid. :func:`match_clouds` searches exhaustively, first on a coarse
 grid (10 cm, 1° steps) over the whole search window, then on a fine grid (2 cm, 0.1°) around
 the coarse optimum. An exhaustive search cannot be caught by a local minimum, which is what a
@@ -18,7 +18,6 @@ from __future__ import annotations
 import functools
 from dataclasses import dataclass
 
-import cv2
 import numpy as np
 from numba import njit
 from numpy.typing import ArrayLike, NDArray
@@ -48,16 +47,64 @@ def voxel_downsample(points: ArrayLike, size: float) -> NDArray[np.float64]:
 
 
 def voxel_index(points: ArrayLike, size: float) -> NDArray[np.intp]:
-    """Indices of the first point of each ``size`` × ``size`` cell, increasing."""
+    """Indices of the first point of each ``size`` × ``size`` cell, increasing.
+
+    Compiled (:func:`_first_per_cell`): the same indices as NumPy's ``np.unique`` on the
+    cells (:func:`_voxel_index_numpy`), a tenth of the time on a scan."""
     p = np.asarray(points, dtype=float).reshape(-1, 2)
     if len(p) == 0:
         return np.zeros(0, dtype=np.intp)
     if not size > 0:
         raise ValueError(f"size must be > 0, got {size}")
+    first = _first_per_cell(p, float(size))
+    return _voxel_index_numpy(p, size) if first is None else first
+
+
+def _voxel_index_numpy(points: ArrayLike, size: float) -> NDArray[np.intp]:
+    """:func:`voxel_index` by ``np.unique`` (the kernel's reference in the tests, and the
+    way for points whose cells an int64 does not hold)."""
+    p = np.asarray(points, dtype=float).reshape(-1, 2)
     k = np.floor(p / size).astype(np.int64)
     k -= k.min(axis=0)
     _, first = np.unique(k[:, 0] * (int(k[:, 1].max()) + 1) + k[:, 1], return_index=True)
     return np.sort(first)
+
+
+@njit(cache=True)
+def _first_per_cell(p, size):  # pragma: no cover
+    """:func:`voxel_index` of ``p`` (N >= 1): one pass marking the cells seen where the
+    cells' box is small against N (a scan's, a submap's), else the first of each run of
+    equal cells in a stable sort; ``None`` if a cell index would not fit an int64."""
+    n = p.shape[0]
+    kx = np.empty(n, np.int64)
+    ky = np.empty(n, np.int64)
+    for i in range(n):
+        fx, fy = np.floor(p[i, 0] / size), np.floor(p[i, 1] / size)
+        if not (abs(fx) < 2.0**52 and abs(fy) < 2.0**52):
+            return None
+        kx[i], ky[i] = np.int64(fx), np.int64(fy)
+    x0, y0 = kx.min(), ky.min()
+    nx, ny = kx.max() - x0 + 1, ky.max() - y0 + 1
+    out = np.empty(n, np.intp)
+    m = 0
+    if float(nx) * float(ny) <= 256.0 * n + 65536.0:
+        seen = np.zeros(nx * ny, np.bool_)
+        for i in range(n):
+            key = (kx[i] - x0) * ny + (ky[i] - y0)
+            if not seen[key]:
+                seen[key] = True
+                out[m] = i
+                m += 1
+        return out[:m]
+    key = (kx - x0) * ny + (ky - y0)
+    order = np.argsort(key, kind="mergesort")
+    out[0] = order[0]
+    m = 1
+    for t in range(1, n):
+        if key[order[t]] != key[order[t - 1]]:
+            out[m] = order[t]
+            m += 1
+    return np.sort(out[:m])
 
 
 def scan_normals(
@@ -70,7 +117,26 @@ def scan_normals(
     step of the point; else
     (an edge, a jump, clutter) the normal is NaN. Neighbours in beam order lie on the same
     surface, so a scan's normals stay sharp where a cloud merged from many scans is blurred.
+
+    Windows of up to 7 points are summed by a compiled kernel (:func:`_window_moments`),
+    value after value as NumPy sums them: the same normals, bit for bit, at a fifth of the
+    time (``tests/test_scanmatch.py``); wider windows, whose sums NumPy pairs up, take the
+    NumPy path (:func:`_scan_normals_numpy`).
     """
+    p = as_points(points, "points")
+    n = len(p)
+    w = 2 * half_window + 1
+    if not 1 <= w <= 7 or n < w:
+        return _scan_normals_numpy(p, half_window, max_gap, max_gap_per_metre)
+    ok, sxx, syy, sxy = _window_moments(p, half_window, float(max_gap), float(max_gap_per_metre))
+    theta = tls_normal_angle(sxx, syy, sxy)  # NumPy's arctan2: numba's differs in last bits
+    out = np.full((n, 2), np.nan)
+    out[half_window : n - half_window][ok] = np.column_stack([np.cos(theta), np.sin(theta)])[ok]
+    return out
+
+
+def _scan_normals_numpy(points, half_window=3, max_gap=0.1, max_gap_per_metre=0.03):
+    """:func:`scan_normals` in NumPy (any window; the kernel's reference in the tests)."""
     p = as_points(points, "points")
     n = len(p)
     out = np.full((n, 2), np.nan)
@@ -94,6 +160,64 @@ def scan_normals(
     return out
 
 
+@njit(cache=True)
+def _window_moments(p, half_window, max_gap, max_gap_per_metre):  # pragma: no cover
+    """For each window of :func:`scan_normals`: whether it passes the gap and the spread
+    tests, and its centred second moments; the operations of the NumPy version in its
+    order (NumPy sums fewer than 8 values one after the other, from +0.0)."""
+    w = 2 * half_window + 1
+    m = p.shape[0] - w + 1
+    ok = np.empty(m, np.bool_)
+    sxx, syy, sxy = np.empty(m), np.empty(m), np.empty(m)
+    for i in range(m):
+        cx, cy = p[i + half_window, 0], p[i + half_window, 1]
+        gap = max_gap + max_gap_per_metre * np.hypot(cx, cy)
+        good = True
+        for j in range(w):
+            good &= np.hypot(p[i + j, 0] - cx, p[i + j, 1] - cy) <= gap * abs(j - half_window)
+        mx, my = 0.0, 0.0  # from +0.0, as NumPy: a sum of -0.0 terms is +0.0
+        for j in range(w):
+            mx += p[i + j, 0]
+            my += p[i + j, 1]
+        mx, my = mx / w, my / w
+        xx, yy, xy = 0.0, 0.0, 0.0
+        for j in range(w):
+            a, b = p[i + j, 0] - mx, p[i + j, 1] - my
+            xx += a * a
+            yy += b * b
+            xy += a * b
+        half, mean = np.hypot(0.5 * (xx - yy), xy), 0.5 * (xx + yy)
+        ok[i] = good and mean - half <= 0.25**2 * (mean + half)
+        sxx[i], syy[i], sxy[i] = xx, yy, xy
+    return ok, sxx, syy, sxy
+
+
+@njit(cache=True)
+def _bounds(p):  # pragma: no cover
+    """``(p.min(axis=0), p.max(axis=0))`` of finite points (N >= 1, 2) in one pass: the same
+    numbers (a minimum is exact), without NumPy's slow column reductions."""
+    low, high = p[0].copy(), p[0].copy()
+    for k in range(1, p.shape[0]):
+        for d in range(2):
+            if p[k, d] < low[d]:
+                low[d] = p[k, d]
+            elif p[k, d] > high[d]:
+                high[d] = p[k, d]
+    return low, high
+
+
+BNB_LEVELS = 4
+"""Levels of the branch-and-bound search: the coarsest blocks are 16 × 16 shifts."""
+
+BNB_MIN_SHIFTS = 8
+"""Windows of fewer than this many shifts either side are searched exhaustively."""
+
+GRID_PAD = 1 << BNB_LEVELS
+"""Cells of 0 around a grid's values (:attr:`LikelihoodGrid.padded`): the pyramid's
+padding, and what lets the exhaustive search add a point's shifted cells without testing
+each against the grid's edges."""
+
+
 @dataclass(frozen=True)
 class LikelihoodGrid:
     """``exp(-d²/2σ²)`` of the distance ``d`` to the nearest target point, per cell.
@@ -107,15 +231,23 @@ class LikelihoodGrid:
     resolution: float
 
     @functools.cached_property
+    def padded(self) -> NDArray[np.float32]:
+        """:attr:`values` with ``GRID_PAD`` cells of 0 on every side (:meth:`build` makes the
+        grid inside this array: :attr:`values` is a view of it)."""
+        h, w = self.values.shape
+        out = np.zeros((h + 2 * GRID_PAD, w + 2 * GRID_PAD), np.float32)
+        out[GRID_PAD : GRID_PAD + h, GRID_PAD : GRID_PAD + w] = self.values
+        return out
+
+    @functools.cached_property
     def pyramid(self) -> NDArray[np.float32]:
         """Max-pooled copies of :attr:`values` for branch and bound, shape
         ``(BNB_LEVELS + 1, rows + 2 p, cols + 2 p)`` with ``p = 2**BNB_LEVELS``: level ``L`` at
         ``[L, p + r, p + c]`` holds the largest value of the ``2**L × 2**L`` cells from
         ``(r, c)`` upwards (cells off the grid count 0). Computed once per grid."""
-        pad = 1 << BNB_LEVELS
-        h, w = self.values.shape
-        out = np.zeros((BNB_LEVELS + 1, h + 2 * pad, w + 2 * pad), np.float32)
-        out[0, pad : pad + h, pad : pad + w] = self.values
+        padded = self.padded
+        out = np.empty((BNB_LEVELS + 1, *padded.shape), np.float32)
+        out[0] = padded
         for level in range(1, BNB_LEVELS + 1):
             s = 1 << (level - 1)
             a, b = out[level - 1], out[level]
@@ -132,23 +264,21 @@ class LikelihoodGrid:
         p = as_points(points, "target points")
         if len(p) == 0:
             raise ValueError("target points must not be empty")
-        lo = p.min(axis=0) - margin
-        shape = np.ceil((p.max(axis=0) + margin - lo) / resolution).astype(int) + 1
-        img = np.full((shape[1], shape[0]), 255, np.uint8)
-        c = np.floor((p - lo) / resolution).astype(int)
-        img[c[:, 1], c[:, 0]] = 0
-        # The exact transform's distance (in cells) is the square root of an integer, but
-        # OpenCV's float32 result varies in its last bit from run to run (seen in 1 of 2
-        # processes on the same input): round the squares back to those integers, so the
-        # grid depends on the points alone.
-        d = cv2.distanceTransform(img, cv2.DIST_L2, cv2.DIST_MASK_PRECISE)
-        # exp(-d²/2σ²) looked up by the integer d² (in cells²); the table runs to where
+        low, high = _bounds(p)
+        lo = low - margin
+        shape = np.ceil((high + margin - lo) / resolution).astype(int) + 1
+        # exp(-d²/2σ²) looked up by the exact integer d² (in cells²); the table runs to where
         # float32 underflows to 0, so the values are exactly those of the formula
         c2 = 0.5 * (resolution / sigma) ** 2
         table = np.exp(-c2 * np.arange(int(np.ceil(104.0 / c2)) + 2)).astype(np.float32)
         table[-1] = 0.0
-        values = _likelihood_lookup(d, table)
-        return cls(values, lo, float(resolution))
+        pad = GRID_PAD
+        padded = _likelihood_grid(
+            p, lo[0], lo[1], float(resolution), int(shape[1]), int(shape[0]), table, pad
+        )
+        grid = cls(padded[pad:-pad, pad:-pad], lo, float(resolution))
+        grid.__dict__["padded"] = padded  # the cached property, computed already
+        return grid
 
     def score(self, points: ArrayLike, pose: ArrayLike) -> float:
         """Mean likelihood of ``points`` placed at ``pose`` (points off the grid score 0)."""
@@ -160,13 +290,66 @@ class LikelihoodGrid:
 
 
 @njit(cache=True)
-def _likelihood_lookup(d, table):  # pragma: no cover
-    out = np.empty(d.shape, np.float32)
+def _likelihood_grid(p, x0, y0, res, h, w, table, pad):  # pragma: no cover
+    """The ``h`` × ``w`` grid of ``table[min(d², last)]``, ``d²`` the exact squared distance
+    (in cells) of each cell to the nearest cell holding a point of ``p`` (cells of ``res``
+    from ``(x0, y0)``), inside ``pad`` cells of 0 on every side.
+
+    The exact Euclidean distance transform of Felzenszwalb and Huttenlocher (2012), in
+    integers: per column the distance to the nearest occupied cell, then per row the lower
+    envelope of the parabolas ``(x - q)² + g(q)²``. Only squares below the table's last
+    entry (0) are needed, so a column distance ``g`` with ``g² > last`` counts as none: it
+    cannot be part of a square below ``last``. The same values as OpenCV's exact transform
+    (``cv2.DIST_MASK_PRECISE``) rounded back to integer squares, at half the time; and they
+    depend on the cells alone (OpenCV's float32 distances varied in their last bit from one
+    process to the next)."""
     last = table.shape[0] - 1
-    for i in range(d.shape[0]):
-        for j in range(d.shape[1]):
-            dd = np.float64(d[i, j])
-            out[i, j] = table[min(int(np.rint(dd * dd)), last)]
+    none = 1
+    while none * none <= last:
+        none += 1
+    g = np.full((h, w), none, np.int32)
+    for k in range(p.shape[0]):
+        g[int(np.floor((p[k, 1] - y0) / res)), int(np.floor((p[k, 0] - x0) / res))] = 0
+    for y in range(1, h):
+        for x in range(w):
+            v = g[y - 1, x] + 1
+            if v < g[y, x]:
+                g[y, x] = v
+    for y in range(h - 2, -1, -1):
+        for x in range(w):
+            v = g[y + 1, x] + 1
+            if v < g[y, x]:
+                g[y, x] = v
+    out = np.zeros((h + 2 * pad, w + 2 * pad), np.float32)
+    vv = np.empty(w, np.int64)  # the envelope's parabolas: apex column...
+    ff = np.empty(w, np.int64)  # ... and height g²
+    zz = np.empty(w + 1, np.float64)  # where each starts
+    for y in range(h):
+        row = out[pad + y, pad : pad + w]
+        k = -1
+        for q in range(w):
+            if g[y, q] >= none:
+                continue
+            fq = np.int64(g[y, q]) * np.int64(g[y, q])
+            s = -np.inf
+            while k >= 0:
+                s = ((fq + q * q) - (ff[k] + vv[k] * vv[k])) / (2.0 * (q - vv[k]))
+                if s > zz[k]:
+                    break
+                k -= 1
+            k += 1
+            vv[k], ff[k], zz[k] = q, fq, s if k > 0 else -np.inf
+        if k < 0:
+            continue  # no point within reach: the row stays 0
+        zz[k + 1] = np.inf
+        j = 0
+        # columns farther than `none` from every apex stay 0 as well
+        for q in range(max(0, vv[0] - none + 1), min(w, vv[k] + none)):
+            while zz[j + 1] < q:
+                j += 1
+            d2 = (q - vv[j]) * (q - vv[j]) + ff[j]
+            if d2 < last:
+                row[q] = table[d2]
     return out
 
 
@@ -199,11 +382,54 @@ def _search(lik, ox, oy, res, px, py, x0, y0, th0, n_t, n_a, da, w_t, w_r):  # p
     return best_acc / max(n, 1), bx, by, bt
 
 
-BNB_LEVELS = 4
-"""Levels of the branch-and-bound search: the coarsest blocks are 16 × 16 shifts."""
-
-BNB_MIN_SHIFTS = 8
-"""Windows of fewer than this many shifts either side are searched exhaustively."""
+@njit(cache=True)
+def _search_padded(
+    padded, pad, ox, oy, res, px, py, x0, y0, th0, n_t, n_a, da, w_t, w_r
+):  # pragma: no cover
+    """:func:`_search` on the grid inside ``pad`` cells of 0 (:attr:`LikelihoodGrid.padded`),
+    point by point: each point adds its cell's (2 n_t + 1)² shifted neighbours to the
+    shifts' sums, without testing each against the grid's edges where the whole block lies
+    within the padding. Every sum adds the same values in the same order as :func:`_search`
+    (a cell in the padding adds 0.0, which leaves a sum of non-negative values as it is), so
+    the result is the same bit for bit, ties included."""
+    hp, wp = padded.shape
+    h, w = hp - 2 * pad, wp - 2 * pad
+    n = px.shape[0]
+    m = 2 * n_t + 1
+    best, bx, by, bt, best_acc = -np.inf, x0, y0, th0, 0.0
+    acc = np.empty((m, m))  # [x shift, y shift]
+    for ka in range(-n_a, n_a + 1):
+        th = th0 + ka * da
+        c, s = np.cos(th), np.sin(th)
+        acc[:, :] = 0.0
+        for k in range(n):
+            ix = int(np.floor((c * px[k] - s * py[k] + x0 - ox) / res))
+            iy = int(np.floor((s * px[k] + c * py[k] + y0 - oy) / res))
+            u0, v0 = ix - n_t + pad, iy - n_t + pad
+            if u0 >= 0 and v0 >= 0 and u0 + m <= wp and v0 + m <= hp:
+                for a in range(m):
+                    for b in range(m):
+                        acc[a, b] += padded[v0 + b, u0 + a]
+            else:
+                for a in range(m):
+                    u = ix - n_t + a
+                    for b in range(m):
+                        v = iy - n_t + b
+                        if 0 <= u < w and 0 <= v < h:
+                            acc[a, b] += padded[v + pad, u + pad]
+        for a in range(m):
+            sx = a - n_t
+            for b in range(m):
+                sy = b - n_t
+                sc = (
+                    acc[a, b] / max(n, 1)
+                    - w_t * res * np.sqrt(sx * sx + sy * sy)
+                    - w_r * abs(ka * da)
+                )
+                if sc > best:
+                    best, bx, by, bt = sc, x0 + sx * res, y0 + sy * res, th
+                    best_acc = acc[a, b]
+    return best_acc / max(n, 1), bx, by, bt
 
 
 @njit(cache=True)
@@ -331,12 +557,17 @@ def correlative_search(
     and ``± window_angle`` (in steps of ``angle_step``, radians).
 
     The search maximises the score minus ``prior[0]`` per metre and ``prior[1]`` per
-    radian of distance from the guess; the score returned is the plain one."""
+    radian of distance from the guess; the score returned is the plain one. Windows of
+    ``BNB_MIN_SHIFTS`` shifts or more are searched by branch and bound, smaller ones
+    exhaustively: the same optimum either way, bit for bit."""
     n_t = round(window / grid.resolution)
     n_a = int(np.ceil(window_angle / angle_step - 1e-9))
-    kernel, table = (_search_bnb, grid.pyramid) if n_t >= BNB_MIN_SHIFTS else (_search, grid.values)
+    if n_t >= BNB_MIN_SHIFTS:
+        kernel, table = _search_bnb, (grid.pyramid,)
+    else:
+        kernel, table = _search_padded, (grid.padded, GRID_PAD)
     s, x, y, t = kernel(
-        table, float(grid.origin[0]), float(grid.origin[1]), grid.resolution,
+        *table, float(grid.origin[0]), float(grid.origin[1]), grid.resolution,
         np.ascontiguousarray(points[:, 0]), np.ascontiguousarray(points[:, 1]),
         float(guess[0]), float(guess[1]), float(guess[2]), n_t, n_a, float(angle_step),
         float(prior[0]), float(prior[1]),
@@ -365,10 +596,28 @@ def _thin(points, n):
 
 
 def _crop(target, query, pose, margin):
+    """The ``target`` points (in order) within ``margin`` of the box around ``query`` placed
+    at ``pose``."""
     q = transform_points(pose, query)
-    lo, hi = q.min(axis=0) - margin, q.max(axis=0) + margin
-    x, y = target[:, 0], target[:, 1]  # column by column: a third of the time
-    return target[(x >= lo[0]) & (x <= hi[0]) & (y >= lo[1]) & (y <= hi[1])]
+    low, high = _bounds(q)
+    lo, hi = low - margin, high + margin
+    return _in_box(target, lo[0], lo[1], hi[0], hi[1])
+
+
+@njit(cache=True)
+def _in_box(p, x0, y0, x1, y1):  # pragma: no cover
+    """The points of ``p`` with ``x0 <= x <= x1`` and ``y0 <= y <= y1``, in order."""
+    n = 0
+    for k in range(p.shape[0]):
+        if x0 <= p[k, 0] <= x1 and y0 <= p[k, 1] <= y1:
+            n += 1
+    out = np.empty((n, 2))
+    n = 0
+    for k in range(p.shape[0]):
+        if x0 <= p[k, 0] <= x1 and y0 <= p[k, 1] <= y1:
+            out[n, 0], out[n, 1] = p[k, 0], p[k, 1]
+            n += 1
+    return out
 
 
 def match_clouds(
@@ -462,7 +711,47 @@ def densify(
     A wall 15 m away is seen by beams 26 cm apart (1° resolution): as points it is a dotted
     line that a likelihood grid scores low wherever a query point falls between the dots;
     filled in, it scores as the wall it is.
+
+    Compiled (:func:`_densify`), with NumPy's operations in its order: the same points and
+    normals, bit for bit.
     """
+    p = as_points(points, "points")
+    nrm = np.asarray(normals, dtype=float).reshape(-1, 2)
+    if len(p) < 2:
+        return p, nrm
+    dense, dense_normals = _densify(p, nrm, float(step), float(max_gap), float(max_gap_per_metre))
+    if len(dense) == len(p):
+        return p, nrm
+    return dense, dense_normals
+
+
+@njit(cache=True)
+def _densify(p, nrm, step, max_gap, max_gap_per_metre):  # pragma: no cover
+    """:func:`densify`: the filled points follow the scan's, pair by pair, each at
+    ``(j + 1) / (k + 1)`` of its pair's gap."""
+    n = p.shape[0]
+    k = np.zeros(n - 1, np.int64)
+    for i in range(n - 1):
+        gap = np.hypot(p[i + 1, 0] - p[i, 0], p[i + 1, 1] - p[i, 1])
+        if gap <= max_gap + max_gap_per_metre * np.hypot(p[i, 0], p[i, 1]):
+            k[i] = int(np.floor(gap / step))
+    total = n + k.sum()
+    out_p, out_n = np.empty((total, 2)), np.empty((total, 2))
+    out_p[:n], out_n[:n] = p, nrm
+    r = n
+    for i in range(n - 1):
+        dx, dy = p[i + 1, 0] - p[i, 0], p[i + 1, 1] - p[i, 1]
+        gap = np.hypot(dx, dy)
+        for j in range(k[i]):
+            t = (j + 1) / (k[i] + 1)
+            out_p[r, 0], out_p[r, 1] = p[i, 0] + t * dx, p[i, 1] + t * dy
+            out_n[r, 0], out_n[r, 1] = -(dy / gap), dx / gap
+            r += 1
+    return out_p, out_n
+
+
+def _densify_numpy(points, normals, step=0.02, max_gap=0.1, max_gap_per_metre=0.03):
+    """:func:`densify` in NumPy (the kernel's reference in the tests)."""
     p = as_points(points, "points")
     nrm = np.asarray(normals, dtype=float).reshape(-1, 2)
     if len(p) < 2:
@@ -533,17 +822,43 @@ class PointMap:
     def _bucketed(cls, p, normals, cell) -> PointMap:
         if not cell > 0:
             raise ValueError(f"cell must be > 0, got {cell}")
-        lo = p.min(axis=0) if len(p) else np.zeros(2)
-        extent = (p.max(axis=0) - lo) if len(p) else np.zeros(2)
+        lo, high = _bounds(p) if len(p) else (np.zeros(2), np.zeros(2))
+        extent = high - lo
         cell = max(cell, float(np.sqrt(np.prod(extent + cell) / 4e6)))  # at most ~4e6 cells
-        ij = np.floor((p - lo) / cell).astype(np.int64)
-        nx, ny = (ij.max(axis=0) + 1) if len(p) else (1, 1)
-        c = ij[:, 0] * ny + ij[:, 1]
-        order = np.argsort(c, kind="stable")
-        starts = np.searchsorted(c[order], np.arange(nx * ny + 1)).astype(np.int64)
         p = np.ascontiguousarray(p)
+        if len(p):
+            nx, ny, starts, order = _bucket(p, lo[0], lo[1], float(cell))
+        else:
+            nx, ny, starts, order = 1, 1, np.zeros(2, np.int64), np.zeros(0, np.int64)
         return cls(p, np.ascontiguousarray(normals), lo, float(cell), (int(nx), int(ny)),
-                   starts, order.astype(np.int64))  # fmt: skip
+                   starts, order)  # fmt: skip
+
+
+@njit(cache=True)
+def _bucket(p, x0, y0, cell):  # pragma: no cover
+    """:class:`PointMap`'s buckets of the points ``p`` (N >= 1) in cells of ``cell`` from
+    ``(x0, y0)``: ``(nx, ny, starts, order)``, ``order`` the points sorted stably by cell
+    ``ix · ny + iy`` (a counting sort: the same order as NumPy's stable argsort) and
+    ``starts[c]`` the number of points in cells before ``c``."""
+    n = p.shape[0]
+    ix = np.empty(n, np.int64)
+    iy = np.empty(n, np.int64)
+    for k in range(n):
+        ix[k] = int(np.floor((p[k, 0] - x0) / cell))
+        iy[k] = int(np.floor((p[k, 1] - y0) / cell))
+    nx, ny = ix.max() + 1, iy.max() + 1
+    starts = np.zeros(nx * ny + 1, np.int64)
+    for k in range(n):
+        starts[ix[k] * ny + iy[k] + 1] += 1
+    for c in range(nx * ny):
+        starts[c + 1] += starts[c]
+    fill = starts[:-1].copy()
+    order = np.empty(n, np.int64)
+    for k in range(n):
+        c = ix[k] * ny + iy[k]
+        order[fill[c]] = k
+        fill[c] += 1
+    return nx, ny, starts, order
 
 
 @njit(cache=True)

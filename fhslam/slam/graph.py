@@ -40,6 +40,7 @@ relative to the keyframe.
 
 from __future__ import annotations
 
+from collections import OrderedDict
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -235,6 +236,82 @@ class LoopClosure:
     """Its edge in :attr:`GraphFastHoughSLAM.graph`."""
 
 
+@dataclass(eq=False)
+class _LoopTarget:
+    """A loop candidate's target: the points and normals of its keyframes in its frame, and
+    (built when first needed) their :class:`fhslam.scanmatch.PointMap`."""
+
+    key: tuple
+    points: NDArray[np.float64]
+    normals: NDArray[np.float64]
+    point_map: PointMap | None = None
+
+    @property
+    def nbytes(self) -> int:
+        m = self.point_map
+        extra = 0 if m is None else sum(a.nbytes for a in (m.points, m.normals, m.starts, m.order))
+        return self.points.nbytes + self.normals.nbytes + extra
+
+
+class LoopTargetCache:
+    """Loop candidates' targets (:class:`_LoopTarget`) kept between keyframes, least
+    recently used first out beyond ``max_bytes``.
+
+    A target is found again only under the same key: its keyframes' range and the exact
+    bytes of their poses in the graph, so a cached target is used only where building it
+    again would give the same bits. Keyframes old enough to be candidates get no more
+    points (scans attach to the newest keyframe), so their poses are all a target depends
+    on. :meth:`drop_moved` forgets the targets whose keyframes an optimisation moved.
+    """
+
+    def __init__(self, max_bytes: int = 8 << 20):
+        self.max_bytes = max_bytes
+        self.nbytes = 0
+        self.hits = self.misses = 0
+        self._targets: OrderedDict[tuple, _LoopTarget] = OrderedDict()
+
+    def __len__(self) -> int:
+        return len(self._targets)
+
+    @staticmethod
+    def key(poses: NDArray[np.float64], members: range) -> tuple:
+        return members.start, members.stop, poses[members.start : members.stop].tobytes()
+
+    def get(self, poses: NDArray[np.float64], members: range, build) -> _LoopTarget:
+        """The target of keyframes ``members`` at ``poses``: cached, else from ``build()``
+        (its points and normals)."""
+        key = self.key(poses, members)
+        target = self._targets.get(key)
+        if target is not None:
+            self.hits += 1
+            self._targets.move_to_end(key)
+            return target
+        self.misses += 1
+        target = self._targets[key] = _LoopTarget(key, *build())
+        self.nbytes += target.nbytes
+        self._evict()
+        return target
+
+    def point_map(self, target: _LoopTarget) -> PointMap:
+        """``target``'s point map, built once."""
+        if target.point_map is None:
+            before = target.nbytes
+            target.point_map = PointMap.build(target.points, target.normals)
+            if self._targets.get(target.key) is target:
+                self.nbytes += target.nbytes - before
+                self._evict()
+        return target.point_map
+
+    def drop_moved(self, poses: NDArray[np.float64]) -> None:
+        """Forget the targets whose keyframes are no longer at their key's poses."""
+        for key in [k for k in self._targets if self.key(poses, range(k[0], k[1])) != k]:
+            self.nbytes -= self._targets.pop(key).nbytes
+
+    def _evict(self) -> None:
+        while self.nbytes > self.max_bytes and self._targets:
+            self.nbytes -= self._targets.popitem(last=False)[1].nbytes
+
+
 def _rotate_information(h: NDArray[np.float64], theta: float) -> NDArray[np.float64]:
     """A pose's information ``h`` (translation in the target frame) re-expressed for the
     pose-graph error, whose translation part is in the frame of the pose itself."""
@@ -278,6 +355,8 @@ class GraphFastHoughSLAM:
         self._kf_doubt = False  # whether a scan since the last keyframe was doubtful
         self._scan_kf: list[int] = []
         self._scan_rel: list[NDArray[np.float64]] = []
+        self.loop_targets = LoopTargetCache()
+        """Loop candidates' targets kept between keyframes (see :class:`LoopTargetCache`)."""
 
     @property
     def keyframe_steps(self) -> NDArray[np.intp]:
@@ -413,9 +492,10 @@ class GraphFastHoughSLAM:
         self._chunks.append([])
         self._kf_lines.append(lines)
 
-    def _submap(self, frame: int, members) -> tuple[NDArray, NDArray]:
-        """Points and normals of keyframes ``members`` in keyframe ``frame``'s frame."""
-        poses = self.graph.poses
+    def _submap(self, frame: int, members, poses=None) -> tuple[NDArray, NDArray]:
+        """Points and normals of keyframes ``members`` in keyframe ``frame``'s frame (at
+        ``poses``, default the graph's)."""
+        poses = self.graph.poses if poses is None else poses
         return self._in_frame(poses, members, poses[frame])
 
     def _close_loops(self, i: int) -> None:
@@ -432,7 +512,7 @@ class GraphFastHoughSLAM:
         ]
         if not cands:
             return
-        query = self._submap(i, range(max(0, i - 2), i + 1))[0]
+        query = self._submap(i, range(max(0, i - 2), i + 1), poses)[0]
         if len(query) < 10:
             return
         # Right after a loop closure the pose is known well: search a small window only.
@@ -442,15 +522,17 @@ class GraphFastHoughSLAM:
         q_refine = voxel_downsample(query, 0.05)
         closed, held = [], []
         for j in cands[:1] if tracking else cands:
-            target, normals = self._submap(
-                j, range(max(0, j - 3), min(j + 4, i - p.loop_min_gap + 1))
+            members = range(max(0, j - 3), min(j + 4, i - p.loop_min_gap + 1))
+            cached = self.loop_targets.get(
+                poses, members, lambda j=j, m=members: self._submap(j, m, poses)
             )
+            target = cached.points
             if len(target) < 10:
                 continue
             m = match_clouds(target, query, relative(poses[j], poses[i]), win, win_deg)
             if m.score < p.loop_min_score:
                 continue
-            ref = refine(PointMap.build(target, normals), q_refine, m.pose)
+            ref = refine(self.loop_targets.point_map(cached), q_refine, m.pose)
             if ref.n_matched < p.loop_min_pairs or ref.rms > p.loop_max_rms:
                 continue
             z = ref.pose if np.hypot(*(ref.pose[:2] - m.pose[:2])) <= 0.05 else m.pose
@@ -502,14 +584,14 @@ class GraphFastHoughSLAM:
         p = self.params
         self.graph.optimize(p.optimize_iterations, p.optimize_tol)
         active = [lc for lc in self.loops if self.graph.is_active(lc.edge)]
-        if not active:
-            return
-        chi2 = self.graph.chi2(np.array([lc.edge for lc in active]))
-        bad = [lc for lc, c in zip(active, chi2, strict=True) if c > p.loop_max_chi2]
-        if bad:
-            for lc in bad:
-                self.graph.set_active(lc.edge, False)
-            self.graph.optimize(p.optimize_iterations, p.optimize_tol)
+        if active:
+            chi2 = self.graph.chi2(np.array([lc.edge for lc in active]))
+            bad = [lc for lc, c in zip(active, chi2, strict=True) if c > p.loop_max_chi2]
+            if bad:
+                for lc in bad:
+                    self.graph.set_active(lc.edge, False)
+                self.graph.optimize(p.optimize_iterations, p.optimize_tol)
+        self.loop_targets.drop_moved(self.graph.poses)
 
     # -- results ---------------------------------------------------------------------------
     @property

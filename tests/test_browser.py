@@ -57,11 +57,23 @@ if _missing():
     )
 
 from selenium import webdriver  # noqa: E402
+from selenium.common.exceptions import StaleElementReferenceException  # noqa: E402
 from selenium.webdriver.chrome.service import Service  # noqa: E402
 from selenium.webdriver.common.action_chains import ActionChains  # noqa: E402
 from selenium.webdriver.common.by import By  # noqa: E402
 from selenium.webdriver.common.keys import Keys  # noqa: E402
 from selenium.webdriver.support.ui import WebDriverWait  # noqa: E402
+
+#: JupyterLab replaces elements as it re-renders (a prompt going from [*] to [3], an output
+#: updated in place): what is read while waiting is read by JavaScript in one go, and a wait
+#: that meets an element replaced under it tries again instead of failing.
+STALE = (StaleElementReferenceException,)
+
+
+def _wait(driver, timeout: float, poll_frequency: float = 0.5) -> WebDriverWait:
+    """``WebDriverWait`` that tries again where an element was replaced under it."""
+    return WebDriverWait(driver, timeout, poll_frequency, ignored_exceptions=STALE)
+
 
 # JupyterLab settings for the test: every cell in the page (no virtual scrolling), no news
 SETTINGS = {
@@ -169,19 +181,27 @@ def _cells(driver):
 
 
 def _status(driver) -> str:
-    found = driver.find_elements(By.CSS_SELECTOR, ".jp-Notebook-ExecutionIndicator")
-    return found[0].get_attribute("data-status") if found else "none"
+    return driver.execute_script(
+        "const e = document.querySelector('.jp-Notebook-ExecutionIndicator');"
+        "return e ? e.getAttribute('data-status') : 'none';"
+    )
+
+
+def _prompts(driver) -> list[str]:
+    """The input prompts' texts (``[3]:``, ``[*]:``), read at once."""
+    return driver.execute_script(
+        "return Array.from(document.querySelectorAll('.jp-InputPrompt'), p => p.innerText.trim());"
+    )
 
 
 def _wait_idle(driver, timeout: float) -> None:
     """Until the kernel is idle and no code cell waits to run ("[*]")."""
 
     def idle(d) -> bool:
-        prompts = [p.text for p in d.find_elements(By.CSS_SELECTOR, ".jp-InputPrompt")]
-        return _status(d) == "idle" and not any("*" in p for p in prompts)
+        return _status(d) == "idle" and not any("*" in p for p in _prompts(d))
 
     time.sleep(0.5)
-    WebDriverWait(driver, timeout, poll_frequency=0.5).until(idle)
+    _wait(driver, timeout, poll_frequency=0.5).until(idle)
 
 
 def _menu(driver, top: str, item: str) -> None:
@@ -191,7 +211,7 @@ def _menu(driver, top: str, item: str) -> None:
             break
     else:
         raise AssertionError(f"no menu {top!r}")
-    WebDriverWait(driver, 10).until(
+    _wait(driver, 10).until(
         lambda d: [
             e for e in d.find_elements(By.CSS_SELECTOR, ".lm-Menu-itemLabel") if e.text == item
         ]
@@ -201,7 +221,11 @@ def _menu(driver, top: str, item: str) -> None:
 
 
 def _output_text(cell) -> str:
-    return "\n".join(e.text for e in cell.find_elements(By.CSS_SELECTOR, ".jp-OutputArea-output"))
+    return cell.parent.execute_script(
+        "return Array.from(arguments[0].querySelectorAll('.jp-OutputArea-output'),"
+        " e => e.innerText.trim()).join('\\n');",
+        cell,
+    )
 
 
 def _type_and_run(driver, cell, source: str) -> None:
@@ -281,8 +305,8 @@ def test_notebook_in_jupyterlab(path, lab, browser):
     driver = browser
     nb = nbformat.read(path, as_version=4)
     driver.get(f"{base}/lab/tree/{path.name}?token={token}&reset")
-    WebDriverWait(driver, 120).until(lambda d: len(_cells(d)) == len(nb.cells))
-    WebDriverWait(driver, 120).until(lambda d: _status(d) == "idle")
+    _wait(driver, 120).until(lambda d: len(_cells(d)) == len(nb.cells))
+    _wait(driver, 120).until(lambda d: _status(d) == "idle")
 
     # Run All: no error, every figure drawn
     t0 = time.perf_counter()
@@ -297,7 +321,7 @@ def test_notebook_in_jupyterlab(path, lab, browser):
         and "Traceback" in _output_text(c)
     ]
     assert not errors, f"{path.name}: error output after Run All: {errors}"
-    prompts = [p.text for p in driver.find_elements(By.CSS_SELECTOR, ".jp-InputPrompt")]
+    prompts = _prompts(driver)
     code = [c for c in nb.cells if c.cell_type == "code"]
     shown = [c for c in code if not c.metadata.get("jupyter", {}).get("source_hidden")]
     assert sum(bool(re.search(r"\[\d+\]", p)) for p in prompts) == len(shown), prompts
@@ -320,7 +344,9 @@ def test_notebook_in_jupyterlab(path, lab, browser):
     for explorer in explorers:
 
         def figures(d, explorer=explorer):
-            return [i.get_attribute("src") for i in explorer.find_elements(By.TAG_NAME, "img")]
+            return d.execute_script(
+                "return Array.from(arguments[0].querySelectorAll('img'), i => i.src);", explorer
+            )
 
         before = figures(driver)
         assert before, f"{path.name}: an explorer without a figure"
@@ -330,7 +356,7 @@ def test_notebook_in_jupyterlab(path, lab, browser):
         t0 = time.perf_counter()
         handle.click()
         ActionChains(driver).send_keys(Keys.ARROW_RIGHT).perform()
-        WebDriverWait(driver, 60, poll_frequency=0.05).until(
+        _wait(driver, 60, poll_frequency=0.05).until(
             lambda d, before=before: figures(d) not in ([], before)
         )
         print(f"{path.name}: explorer redrawn {time.perf_counter() - t0:.2f} s after a key")
@@ -342,9 +368,8 @@ def test_notebook_in_jupyterlab(path, lab, browser):
         for answer, mark in zip(
             answers(task, check, solution), ("❌ not yet", "✅ correct"), strict=True
         ):
-            cells = _cells(driver)
-            _type_and_run(driver, cells[i + 1], answer)
-            _run_cell(driver, cells[i + 2])
+            _type_and_run(driver, _cells(driver)[i + 1], answer)
+            _run_cell(driver, _cells(driver)[i + 2])
             said = _output_text(_cells(driver)[i + 2])
             assert said.startswith(mark), f"{path.name}, {title}: {answer!r} gave {said!r}"
             assert "Traceback" not in said and said.count("\n") == 0, said

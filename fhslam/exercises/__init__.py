@@ -29,10 +29,13 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
+import numpy as np
+
 __all__ = [
     "Feedback",
     "Wrong",
     "call",
+    "check_band",
     "check_choice",
     "check_value",
     "exercise",
@@ -152,3 +155,30 @@ def check_choice(answer: Any, right: str, why: dict[str, str], what: str = "my_a
         return f"({letter}): {why[letter]}"
 
     return check(answer)
+
+
+def check_band(
+    answer: Any,
+    value: float,
+    bands: dict[str, tuple[float, float, str]],
+    shown: str,
+    right: str,
+    too_low: str,
+    too_high: str,
+    what: str = "my_prediction",
+) -> Feedback:
+    """A predicted range, a letter among ``bands`` (letter -> (lowest, highest, wording), in
+    increasing order, each from its lowest value up to the next one's): the right letter is
+    the band holding ``value``. Each choice is explained as its wording and ``shown`` (how
+    ``value`` came about), then ``right`` for the right band, ``too_low`` for a band below it
+    or ``too_high`` for one above it (why the value is not that small or large)."""
+    letters = list(bands)
+    lows = [low for low, _, _ in bands.values()][1:]
+    k = int(np.searchsorted(lows, value, side="right"))
+    why = {}
+    for i, (letter, (_, _, words)) in enumerate(bands.items()):
+        if i == k:
+            why[letter] = f"{words}: {shown}{right}"
+        else:
+            why[letter] = f"{words}: it is {shown}. {too_low if i < k else too_high}"
+    return check_choice(answer, letters[k], why, what=what)

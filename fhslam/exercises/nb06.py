@@ -9,7 +9,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike
 
-from fhslam.exercises import Feedback, Wrong, call, check_choice, exercise
+from fhslam.exercises import Feedback, Wrong, call, check_band, check_choice, exercise
 from fhslam.metrics import ate
 
 __all__ = [
@@ -38,30 +38,18 @@ def check_drift_ratio(
     from the notebook's run with :func:`fhslam.metrics.ate`."""
     odo, slam = ate(odometry, truth).rmse, ate(slam_poses, truth).rmse
     ratio = odo / slam if slam > 0 else np.inf
-    bounds = [lo for lo, _, _ in RATIO_CHOICES.values()][1:]
-    right = list(RATIO_CHOICES)[int(np.searchsorted(bounds, ratio, side="right"))]
-    values = f"odometry {odo:.2f} m / FH-SLAM {slam:.3f} m = {ratio:.0f} times"
-    letters = list(RATIO_CHOICES)
-    why = {}
-    for letter, (_, _, words) in RATIO_CHOICES.items():
-        if letter == right:
-            why[letter] = (
-                f"{words}: {values} — metres of odometry drift against the centimetres to which "
-                "the matched lines fix each pose."
-            )
-        elif letters.index(letter) < letters.index(right):
-            why[letter] = (
-                f"{words}: it is {values}. FH-SLAM only predicts from the odometry; Loop 3 "
-                "then calibrates every pose on the matched reference lines, so the drift never "
-                "builds up."
-            )
-        else:
-            why[letter] = (
-                f"{words}: it is {values}. FH-SLAM cannot beat the lines it matches: they are "
-                "fitted to points with about 1 cm of range noise, and along a corridor no line "
-                "fixes the position."
-            )
-    return check_choice(answer, right, why, what="my_prediction")
+    return check_band(
+        answer,
+        ratio,
+        RATIO_CHOICES,
+        f"odometry {odo:.2f} m / FH-SLAM {slam:.3f} m = {ratio:.0f} times",
+        right=" — metres of odometry drift against the centimetres to which the matched lines "
+        "fix each pose.",
+        too_low="FH-SLAM only predicts from the odometry; Loop 3 then calibrates every pose on "
+        "the matched reference lines, so the drift never builds up.",
+        too_high="FH-SLAM cannot beat the lines it matches: they are fitted to points with "
+        "about 1 cm of range noise, and along a corridor no line fixes the position.",
+    )
 
 
 def ate_cases() -> list[tuple[str, np.ndarray, np.ndarray]]:

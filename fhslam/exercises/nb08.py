@@ -9,7 +9,7 @@ from typing import Any, Protocol
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from fhslam.exercises import Feedback, Wrong, call, check_choice, exercise
+from fhslam.exercises import Feedback, Wrong, call, check_band, check_choice, exercise
 from fhslam.geometry import compose, inverse, relative
 from fhslam.metrics import relations_error, relations_errors
 
@@ -50,33 +50,24 @@ def check_paper_vs_odometry(
     odo = relations_error(odometry.timestamps, odometry.poses, t1, t2, rel).trans_mean
     fht = relations_error(paper.timestamps, paper.poses, t1, t2, rel).trans_mean
     ratio = odo / fht if fht > 0 else np.inf
-    bounds = [lo for lo, _, _ in GAIN_CHOICES.values()][1:]
-    right = list(GAIN_CHOICES)[int(np.searchsorted(bounds, ratio, side="right"))]
-    values = f"odometry {odo:.2f} m / paper's procedure {fht:.2f} m = {ratio:.1f}"
-    letters = list(GAIN_CHOICES)
-    why = {}
-    for letter, (_, _, words) in GAIN_CHOICES.items():
-        if letter == right:
-            why[letter] = f"{words}: {values}." + (
-                " The matched reference lines correct each pose, so the procedure drifts more "
-                "slowly than the odometry, but nothing ever pulls it back: over the whole log "
-                "the drift still adds up."
-                if letter == "b"
-                else ""
-            )
-        elif letters.index(letter) < letters.index(right):
-            why[letter] = (
-                f"{words}: it is {values}. Matching the scan's lines to the reference lines "
-                "corrects the heading step by step, and the heading is what makes odometry "
-                "drift, so the procedure does help."
-            )
-        else:
-            why[letter] = (
-                f"{words}: it is {values}. Each new reference line is placed with the pose of "
-                "its time and never corrected, and without loop closure a return to a room "
-                "does not pull the map together again: the small errors add up over minutes."
-            )
-    return check_choice(answer, right, why, what="my_prediction")
+    low, high, _ = GAIN_CHOICES["b"]
+    slower = (
+        " The matched reference lines correct each pose, so the procedure drifts more slowly "
+        "than the odometry, but nothing ever pulls it back: over the whole log the drift still "
+        "adds up."
+    )
+    return check_band(
+        answer,
+        ratio,
+        GAIN_CHOICES,
+        f"odometry {odo:.2f} m / paper's procedure {fht:.2f} m = {ratio:.1f}",
+        right="." + (slower if low <= ratio < high else ""),
+        too_low="Matching the scan's lines to the reference lines corrects the heading step by "
+        "step, and the heading is what makes odometry drift, so the procedure does help.",
+        too_high="Each new reference line is placed with the pose of its time and never "
+        "corrected, and without loop closure a return to a room does not pull the map "
+        "together again: the small errors add up over minutes.",
+    )
 
 
 def _reference(pose_1: np.ndarray, pose_2: np.ndarray, relation: np.ndarray) -> float:

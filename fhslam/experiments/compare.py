@@ -10,9 +10,12 @@ from __future__ import annotations
 
 import csv
 import os
+import signal
+import threading
 import time
 import warnings
-from collections.abc import Sequence
+from collections.abc import Iterator, Sequence
+from contextlib import contextmanager
 from dataclasses import astuple, dataclass, fields, replace
 from pathlib import Path
 
@@ -123,13 +126,47 @@ def slam_sweep(
         raise ValueError(f"unknown SLAM methods {sorted(unknown)}; choose from {list(METHODS)}")
     jobs = [(lv, s) for lv in levels for s in seeds]
     par = Parallel(n_jobs=n_jobs, return_as="generator")
-    results = par(delayed(one_run)(world, lv, s, tuple(methods)) for lv, s in jobs)
+    with _workers_deaf_to_ctrl_c():  # the call starts the worker processes
+        results = par(delayed(one_run)(world, lv, s, tuple(methods)) for lv, s in jobs)
     rows: list[RunResult] = []
     for batch in tqdm(
         results, total=len(jobs), desc="SLAM sweep", unit="log", disable=not progress
     ):
         rows.extend(batch)
     return rows
+
+
+@contextmanager
+def _workers_deaf_to_ctrl_c() -> Iterator[None]:
+    """Block SIGINT in this thread while worker processes are started, so that they inherit
+    the block and only this process answers Ctrl-C.
+
+    A terminal sends Ctrl-C to its whole foreground process group, workers included, and a
+    worker hit between two tasks prints a traceback of its own. Here the process that
+    started the workers gets the Ctrl-C (a blocked signal stays pending and arrives as
+    KeyboardInterrupt when the block ends) and joblib ends the workers. Threads started in
+    the block (joblib's, loky's) inherit it too; Python runs signal handlers in the main
+    thread whichever thread the signal is delivered to.
+
+    The resource trackers are started first: Python's own (3.11-3.13) ends its start by
+    unblocking SIGINT instead of restoring the mask it found.
+    """
+    if not hasattr(signal, "pthread_sigmask") or threading.current_thread() is not (
+        threading.main_thread()
+    ):
+        yield
+        return
+    from multiprocessing import resource_tracker
+
+    from joblib.externals.loky.backend import resource_tracker as loky_resource_tracker
+
+    resource_tracker.ensure_running()
+    loky_resource_tracker.ensure_running()
+    old = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
+    try:
+        yield
+    finally:
+        signal.pthread_sigmask(signal.SIG_SETMASK, old)
 
 
 def summary(rows: Sequence[RunResult]) -> dict[tuple[str, str], dict[str, float]]:

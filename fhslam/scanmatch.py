@@ -70,7 +70,7 @@ def _voxel_index_numpy(points: ArrayLike, size: float) -> NDArray[np.intp]:
     return np.sort(first)
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def _first_per_cell(p, size):  # pragma: no cover
     """:func:`voxel_index` of ``p`` (N >= 1): one pass marking the cells seen where the
     cells' box is small against N (a scan's, a submap's), else the first of each run of
@@ -160,7 +160,7 @@ def _scan_normals_numpy(points, half_window=3, max_gap=0.1, max_gap_per_metre=0.
     return out
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def _window_moments(p, half_window, max_gap, max_gap_per_metre):  # pragma: no cover
     """For each window of :func:`scan_normals`: whether it passes the gap and the spread
     tests, and its centred second moments; the operations of the NumPy version in its
@@ -192,7 +192,7 @@ def _window_moments(p, half_window, max_gap, max_gap_per_metre):  # pragma: no c
     return ok, sxx, syy, sxy
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def _bounds(p):  # pragma: no cover
     """``(p.min(axis=0), p.max(axis=0))`` of finite points (N >= 1, 2) in one pass: the same
     numbers (a minimum is exact), without NumPy's slow column reductions."""
@@ -289,7 +289,7 @@ class LikelihoodGrid:
         return float(self.values[c[ok, 1], c[ok, 0]].sum() / max(len(p), 1))
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def _likelihood_grid(p, x0, y0, res, h, w, table, pad):  # pragma: no cover
     """The ``h`` × ``w`` grid of ``table[min(d², last)]``, ``d²`` the exact squared distance
     (in cells) of each cell to the nearest cell holding a point of ``p`` (cells of ``res``
@@ -353,7 +353,7 @@ def _likelihood_grid(p, x0, y0, res, h, w, table, pad):  # pragma: no cover
     return out
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def _search(lik, ox, oy, res, px, py, x0, y0, th0, n_t, n_a, da, w_t, w_r):  # pragma: no cover
     h, w = lik.shape
     n = px.shape[0]
@@ -382,7 +382,7 @@ def _search(lik, ox, oy, res, px, py, x0, y0, th0, n_t, n_a, da, w_t, w_r):  # p
     return best_acc / max(n, 1), bx, by, bt
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def _search_padded(
     padded, pad, ox, oy, res, px, py, x0, y0, th0, n_t, n_a, da, w_t, w_r
 ):  # pragma: no cover
@@ -432,7 +432,7 @@ def _search_padded(
     return best_acc / max(n, 1), bx, by, bt
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def _bound(pyr, level, pad, ix, iy, sx, sy):  # pragma: no cover
     """Sum over the points of the level's pooled value at their cell + (sx, sy)."""
     h, w = pyr.shape[1], pyr.shape[2]
@@ -445,7 +445,7 @@ def _bound(pyr, level, pad, ix, iy, sx, sy):  # pragma: no cover
     return acc
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def _search_bnb(pyr, ox, oy, res, px, py, x0, y0, th0, n_t, n_a, da, w_t, w_r):  # pragma: no cover
     """:func:`_search` by branch and bound over the max-pooled grids ``pyr``
     (:attr:`LikelihoodGrid.pyramid`): the same optimum, ties broken the same way (the first
@@ -530,7 +530,7 @@ def _search_bnb(pyr, ox, oy, res, px, py, x0, y0, th0, n_t, n_a, da, w_t, w_r): 
     return best_acc / nn, x0 + bx_ * res, y0 + by_ * res, th0 + (ba - n_a) * da
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def _block_score(
     pyr, level, pad, ix, iy, sx, sy, n_t, ka, nn, res, da, w_t, w_r
 ):  # pragma: no cover
@@ -604,7 +604,7 @@ def _crop(target, query, pose, margin):
     return _in_box(target, lo[0], lo[1], hi[0], hi[1])
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def _in_box(p, x0, y0, x1, y1):  # pragma: no cover
     """The points of ``p`` with ``x0 <= x <= x1`` and ``y0 <= y <= y1``, in order."""
     n = 0
@@ -725,7 +725,7 @@ def densify(
     return dense, dense_normals
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def _densify(p, nrm, step, max_gap, max_gap_per_metre):  # pragma: no cover
     """:func:`densify`: the filled points follow the scan's, pair by pair, each at
     ``(j + 1) / (k + 1)`` of its pair's gap."""
@@ -834,7 +834,7 @@ class PointMap:
                    starts, order)  # fmt: skip
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def _bucket(p, x0, y0, cell):  # pragma: no cover
     """:class:`PointMap`'s buckets of the points ``p`` (N >= 1) in cells of ``cell`` from
     ``(x0, y0)``: ``(nx, ny, starts, order)``, ``order`` the points sorted stably by cell
@@ -861,7 +861,7 @@ def _bucket(p, x0, y0, cell):  # pragma: no cover
     return nx, ny, starts, order
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def _accumulate(
     q0, x, y, th, pts, nrm, lo, cell, nx, ny, starts, order, max_d, huber
 ):  # pragma: no cover

@@ -58,6 +58,23 @@ def test_stage_timer_patches_one_instance_only():
     assert "f" not in vars(b) and Thing.f is not a.f
 
 
+def test_stage_timer_nests_per_thread_and_keeps_other_threads_apart():
+    import threading
+
+    timer = StageTimer()
+    inner = timer.wrap(lambda: threading.Event().wait(0.05), "inner")
+    outer = timer.wrap(lambda: inner(), "outer")
+    t = threading.Thread(target=inner)
+    t.start()
+    outer()  # while the other thread's inner call runs: it is not nested in this one
+    t.join()
+    assert timer.calls == {"inner": 2, "outer": 1}
+    assert timer.off_main == {"inner": pytest.approx(timer.seconds["inner"] / 2, rel=0.5)} | {
+        "outer": 0.0
+    }
+    assert 0 <= timer.seconds["outer"] < 0.05  # its own inner call only was subtracted
+
+
 def test_stage_timer_counts_a_call_that_raises():
     timer = StageTimer()
     f = timer.wrap(lambda: 1 / 0, "broken")
@@ -81,7 +98,10 @@ def test_log_bench_stages_add_up_to_the_total(short_log, method):
     assert isinstance(b, LogBench)
     assert list(b.stages) == [*STAGES.get(method, ()), "other"]
     assert all(s >= 0 for s in b.stages.values())
-    assert sum(b.stages.values()) <= b.seconds + 1e-9
+    # the main thread's stages add up to at most the wall time; the back end's overlap them
+    assert sum(b.stages.values()) - sum(b.parallel.values()) <= b.seconds + 1e-9
+    assert all(0 < b.parallel[k] <= b.stages[k] for k in b.parallel)
+    assert set(b.parallel) <= ({"loop closure", "optimisation"} if method == "graph" else set())
     assert b.n_scans == len(short_log) == 60
     assert b.steps_per_second == pytest.approx(b.n_scans / b.seconds)
     span = short_log.timestamps[-1] - short_log.timestamps[0]
@@ -92,8 +112,10 @@ def test_log_bench_stages_add_up_to_the_total(short_log, method):
         assert b.calls["extraction"] > 0 and b.calls["map"] >= 1
     if method == "graph":
         assert b.calls["tracking"] == len(short_log) - 1  # every scan but the first
+        assert "loop closure" in b.parallel  # on the back end's thread
     table = format_log_bench(b)
     assert "60 scans" in table and "total" in table
+    assert ("ran on the back end's thread" in table) == (method == "graph")
 
 
 def test_log_bench_medians_over_repeats(short_log):

@@ -70,6 +70,59 @@ def test_same_log_same_numbers(three_laps):
     np.testing.assert_array_equal(a, b)
 
 
+def test_the_back_ends_thread_changes_no_bit(three_laps):
+    """The back end on its own thread (the default) gets the same calls in the same order as
+    in turn: the same poses, closures and graph, bit for bit."""
+    runs = []
+    for background in (True, False):
+        slam = GraphFastHoughSLAM(background=background)
+        runs.append((run_backend(slam, three_laps).poses, slam))
+    (a, sa), (b, sb) = runs
+    np.testing.assert_array_equal(a, b)
+    assert [(lc.old, lc.new, lc.score) for lc in sa.loops] == [
+        (lc.old, lc.new, lc.score) for lc in sb.loops
+    ]
+    np.testing.assert_array_equal(sa.graph.poses, sb.graph.poses)
+    assert sa._worker is None  # finish() let the thread end
+
+
+def test_the_back_end_raises_in_the_callers_thread(three_laps):
+    """An error on the back end's thread surfaces at the next keyframe or read, not lost."""
+    slam = GraphFastHoughSLAM()
+
+    def broken(i):
+        raise RuntimeError(f"no loops at keyframe {i}")
+
+    slam._close_loops = broken
+    with pytest.raises(RuntimeError, match="no loops at keyframe 1"):
+        run_backend(slam, three_laps)
+
+
+def test_a_dropped_slam_leaves_no_thread_behind(three_laps):
+    import gc
+    import threading
+    import weakref
+
+    from fhslam.experiments.bench import log_head
+
+    before = threading.active_count()
+    slam = GraphFastHoughSLAM()
+    for k in range(40):  # some keyframes, no finish(): the thread is still there
+        slam.step(three_laps.scan(k), three_laps.odometry[k])
+    assert slam._worker is not None and threading.active_count() == before + 1
+    slam.sync()  # the calls still queued hold the object
+    gone = weakref.ref(slam)
+    del slam
+    gc.collect()
+    assert gone() is None
+    for _ in range(100):  # the thread ends once it sees the object collected
+        if threading.active_count() == before:
+            break
+        threading.Event().wait(0.01)
+    assert threading.active_count() == before
+    assert len(run_slam(log_head(three_laps, 40), "graph").poses) == 40
+
+
 def test_dropped_scans_and_clutter(three_laps):
     """10% of the scans dropped, 5% clutter returns: every scan still gets a pose."""
     log = degrade(three_laps, drop_fraction=0.1, clutter_fraction=0.05, seed=1)

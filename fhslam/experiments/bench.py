@@ -18,6 +18,7 @@ scans before and after the run, so they compare across machines.
 from __future__ import annotations
 
 import functools
+import threading
 import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field, replace
@@ -191,7 +192,9 @@ class StageTimer:
     Nested stages are subtracted: a stage's time is *exclusive*. While a wrapped call runs
     inside another wrapped call (``_optimize`` inside ``_close_loops``), its time counts to
     its own stage only and is taken off the enclosing one; so no second counts twice and the
-    stages of a run add up to at most its wall time.
+    stages of the main thread add up to at most its wall time. Calls on other threads nest
+    per thread, and their seconds are also kept in :attr:`off_main`: they overlap the main
+    thread's.
 
     Examples
     --------
@@ -206,26 +209,39 @@ class StageTimer:
         """Seconds from an arbitrary origin (a fake clock makes a test exact)."""
         self.seconds: dict[str, float] = {}
         self.calls: dict[str, int] = {}
-        self._open: list[float] = []  # per open wrapped call: seconds of wrapped calls inside
+        self.off_main: dict[str, float] = {}
+        """Of :attr:`seconds`, those spent on threads other than the main thread."""
+        self._lock = threading.Lock()
+        self._local = threading.local()
+
+    @property
+    def _open(self) -> list[float]:
+        """This thread's open wrapped calls: per call, the seconds of wrapped calls inside."""
+        return self._local.__dict__.setdefault("open", [])
 
     def wrap(self, fn: Callable, stage: str) -> Callable:
         """``fn``, timed into ``stage`` (see the class docs)."""
         self.seconds.setdefault(stage, 0.0)
         self.calls.setdefault(stage, 0)
+        self.off_main.setdefault(stage, 0.0)
 
         @functools.wraps(fn)
         def timed(*args, **kwargs):
-            self._open.append(0.0)
+            open_calls = self._open
+            open_calls.append(0.0)
             t0 = self.clock()
             try:
                 return fn(*args, **kwargs)
             finally:
                 dt = self.clock() - t0
-                inner = self._open.pop()
-                self.seconds[stage] += dt - inner
-                self.calls[stage] += 1
-                if self._open:
-                    self._open[-1] += dt
+                inner = open_calls.pop()
+                with self._lock:
+                    self.seconds[stage] += dt - inner
+                    self.calls[stage] += 1
+                    if threading.current_thread() is not threading.main_thread():
+                        self.off_main[stage] += dt - inner
+                if open_calls:
+                    open_calls[-1] += dt
 
         return timed
 
@@ -235,7 +251,15 @@ class StageTimer:
 
 
 STAGES: dict[str, tuple[str, ...]] = {
-    "graph": ("extraction", "tracking", "local map", "loop closure", "optimisation", "map"),
+    "graph": (
+        "extraction",
+        "tracking",
+        "local map",
+        "loop closure",
+        "optimisation",
+        "waiting",
+        "map",
+    ),
     "fht": ("extraction", "association", "map"),
     "classical": ("extraction", "association", "map"),
 }
@@ -244,8 +268,11 @@ time). ``graph`` (:class:`fhslam.slam.GraphFastHoughSLAM`): *extraction* the key
 (the ``lines.extractor`` parameter), *tracking* scan-to-map matching (``tracker.track``),
 *local map* rebuilding the tracker's grids at each keyframe (``_update_local_map``), *loop
 closure* the search and verification of closures (``_close_loops`` less the optimisation it
-calls), *optimisation* the pose-graph solves (``_optimize``), *map* the map of reference lines
-at the end (``build_map``); *other* holds the keyframe clouds (densify, normals, voxel filter),
+calls), *optimisation* the pose-graph solves (``_optimize``), both on the back end's own thread
+while the front end goes on (until the last keyframe), *waiting* the front end waiting for the
+back end (``sync``, and ``_in_turn`` when the back end is behind; without a background thread
+it adds the keyframes to the graph), *map* the map of reference lines at the end
+(``build_map``); *other* holds the keyframe clouds (densify, normals, voxel filter),
 pose arithmetic and the driver. ``fht`` and ``classical`` (:class:`fhslam.slam.FastHoughSLAM`):
 *extraction* Loop 1 (``extract``), *association* Loop 2 (``map.nearby`` and ``map.associate``),
 *map* merging into the reference lines (``map.update``); *other* is mostly the pose calibration
@@ -267,6 +294,8 @@ def instrumented_backend(method: str, timer: StageTimer):
         timer.patch(backend, "_update_local_map", "local map")
         timer.patch(backend, "_close_loops", "loop closure")
         timer.patch(backend, "_optimize", "optimisation")
+        timer.patch(backend, "_in_turn", "waiting")
+        timer.patch(backend, "sync", "waiting")
         timer.patch(backend, "build_map", "map")
     elif method in ("fht", "classical"):
         backend = make_backend(method)
@@ -332,7 +361,11 @@ class LogBench:
         over the repeats.
     stages : dict of str to float
         Exclusive wall seconds per stage (:data:`STAGES`, then ``"other"``: the rest of the
-        run), each the median over the repeats (with one repeat they add up to ``seconds``).
+        run), each the median over the repeats (with one repeat, the main thread's add up to
+        ``seconds``).
+    parallel : dict of str to float
+        Of ``stages``, the seconds spent on another thread (the graph's back end), which
+        overlap the main thread's (median over the repeats).
     calls : dict of str to int
         Calls of each stage in one run.
     reference_seconds : float
@@ -350,6 +383,7 @@ class LogBench:
     calls: dict[str, int] = field(repr=False)
     reference_seconds: float
     repeats: int
+    parallel: dict[str, float] = field(default_factory=dict, repr=False)
 
     @property
     def steps_per_second(self) -> float:
@@ -378,7 +412,8 @@ def run_log_bench(
 
     Each run gets a fresh back end (:func:`fhslam.pipeline.make_backend`) whose stage methods
     are wrapped by a :class:`StageTimer` on the instance (:data:`STAGES`; nested stages are
-    subtracted, so the stages plus ``"other"`` add up to the run's wall time), driven by
+    subtracted, so the main thread's stages plus ``"other"`` add up to the run's wall time;
+    :attr:`LogBench.parallel` tells what ran on the back end's thread), driven by
     :func:`fhslam.pipeline.run_backend`. The reference call is timed on a sample of the log's
     scans right before and right after each run, so that machine load hits both alike. A
     short untimed run over the first scans warms up JIT-compiled code and caches first.
@@ -393,7 +428,7 @@ def run_log_bench(
     samples = _reference_samples(log)
     run_backend(make_backend(method), log_head(log, 20))  # warm-up: JIT, caches
     _reference_seconds(samples[:1], 1)
-    totals, refs, stage_runs = [], [], []
+    totals, refs, stage_runs, parallel_runs = [], [], [], []
     calls: dict[str, int] = {}
     for r in range(repeats):
         before = _reference_seconds(samples)
@@ -405,10 +440,11 @@ def run_log_bench(
         total = time.perf_counter() - t0
         after = _reference_seconds(samples)
         stages = dict(timer.seconds)
-        stages["other"] = total - sum(stages.values())
+        stages["other"] = total - sum(stages.values()) + sum(timer.off_main.values())
         totals.append(total)
         refs.append((before + after) / 2)
         stage_runs.append(stages)
+        parallel_runs.append({k: v for k, v in timer.off_main.items() if v > 0})
         calls = dict(timer.calls)
     duration = float(log.timestamps[-1] - log.timestamps[0])
     return LogBench(
@@ -421,6 +457,10 @@ def run_log_bench(
         calls=calls,
         reference_seconds=float(np.median(refs)),
         repeats=repeats,
+        parallel={
+            k: float(np.median([p.get(k, 0.0) for p in parallel_runs]))
+            for k in dict.fromkeys(k for p in parallel_runs for k in p)
+        },
     )
 
 
@@ -448,4 +488,10 @@ def format_log_bench(b: LogBench) -> str:
     lines.append(
         f"{'total':<14} {b.ms_per_scan():9.3f} {100.0:6.1f}% {b.ratio_to_reference():9.2f}"
     )
+    if b.parallel:
+        off = sum(b.parallel.values())
+        lines.append(
+            f"{off:.2f} s of {', '.join(b.parallel)} ran on the back end's thread, overlapping "
+            f"the rest: the stages add up to {100 * (1 + off / b.seconds):.0f} % of the wall time"
+        )
     return "\n".join(lines)

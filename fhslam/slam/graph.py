@@ -34,12 +34,22 @@ line describes. What this module adds, each measured in the README:
 Each scan's pose is its keyframe's optimised pose composed with the scan's tracked pose
 relative to the keyframe.
 
+**Two threads.** The front end (tracking, keyframes, their clouds and lines) never reads the
+graph: it tracks in its own frame. So the back end (adding each keyframe to the graph, its
+loop closures, the optimisations) runs on a thread of its own, a keyframe behind, while the
+front end tracks the next scans; the compiled kernels release the GIL, so on two cores the
+halves overlap. The back end gets the same calls in the same order either way, and the
+results are the same bit for bit (``background=False`` runs it in turn).
+
 ``fhslam slam LOG`` runs it (``method="graph"`` in :func:`fhslam.pipeline.run_slam`);
 ``method="fht"`` stays the paper's procedure.
 """
 
 from __future__ import annotations
 
+import queue
+import threading
+import weakref
 from collections import OrderedDict
 from dataclasses import dataclass, field
 
@@ -312,6 +322,64 @@ class LoopTargetCache:
             self.nbytes -= self._targets.popitem(last=False)[1].nbytes
 
 
+class _InOrder:
+    """A thread that runs the calls given to it one after another, in the order given.
+
+    The back end of :class:`GraphFastHoughSLAM` (adding keyframes to the pose graph, loop
+    closures, optimisation) runs here while the front end tracks the next scans: the two
+    share nothing that either changes while the other reads it (the front end tracks in its
+    own frame, and a keyframe's cloud is complete before the back end reads it), and the
+    back end gets the same calls in the same order as without the thread, so the results are
+    the same bit for bit. The compiled kernels release the GIL, so on two cores the two
+    halves overlap.
+
+    A call that raises stops the rest; :meth:`wait` raises it. ``max_queued`` calls at most
+    wait their turn (:meth:`submit` blocks beyond): the back end cannot fall far behind.
+    The thread holds no reference to the calls it has run, and ends when :meth:`close` is
+    called or this object is collected.
+    """
+
+    def __init__(self, max_queued: int = 32):
+        self._queue: queue.Queue = queue.Queue(max_queued)
+        self._failed: list[BaseException] = []
+        thread = threading.Thread(
+            target=_InOrder._serve, args=(self._queue, self._failed), daemon=True
+        )
+        thread.start()
+        weakref.finalize(self, self._queue.put, None)
+
+    @staticmethod
+    def _serve(jobs: queue.Queue, failed: list[BaseException]) -> None:
+        while (job := jobs.get()) is not None:
+            try:
+                if not failed:
+                    job[0](*job[1])
+            except BaseException as e:  # re-raised by wait() in the caller's thread
+                failed.append(e)
+            finally:
+                del job
+                jobs.task_done()
+        jobs.task_done()
+
+    def submit(self, fn, *args) -> None:
+        """Queue ``fn(*args)``; raises what an earlier call raised."""
+        self._raise()
+        self._queue.put((fn, args))
+
+    def wait(self) -> None:
+        """Block until every call given so far has run; raise what one raised."""
+        self._queue.join()
+        self._raise()
+
+    def close(self) -> None:
+        """Let the thread end once the calls given so far have run."""
+        self._queue.put(None)
+
+    def _raise(self) -> None:
+        if self._failed:
+            raise self._failed[0]
+
+
 def _rotate_information(h: NDArray[np.float64], theta: float) -> NDArray[np.float64]:
     """A pose's information ``h`` (translation in the target frame) re-expressed for the
     pose-graph error, whose translation part is in the frame of the pose itself."""
@@ -329,15 +397,24 @@ class GraphFastHoughSLAM:
     params : GraphSlamParams, optional
     initial_pose : array-like, shape (3,), optional
         The pose of the first scan; default: the first odometry pose.
+    background : bool
+        Run the back end (the pose graph, loop closures, optimisation) on a thread of its
+        own while the front end tracks the next scans (see :class:`_InOrder`): the same
+        results, bit for bit, as ``False``, which runs it in turn.
     """
 
     def __init__(
-        self, params: GraphSlamParams | None = None, initial_pose: ArrayLike | None = None
+        self,
+        params: GraphSlamParams | None = None,
+        initial_pose: ArrayLike | None = None,
+        background: bool = True,
     ):
         self.params = params or GraphSlamParams()
         self.tracker = ScanTracker(self.params.tracker)
-        self.graph = PoseGraph()
-        self.loops: list[LoopClosure] = []
+        self._graph = PoseGraph()
+        self._loops: list[LoopClosure] = []
+        self._background = background
+        self._worker: _InOrder | None = None
         self._initial = None if initial_pose is None else as_pose(initial_pose, "initial_pose")
         self.origin: NDArray[np.float64] | None = None
         """The first scan's pose: the graph runs in its frame (see :meth:`step`)."""
@@ -404,7 +481,7 @@ class GraphFastHoughSLAM:
                     else extract_lines(all_points, fe.extraction)
                 )
             self._new_keyframe(pose, lines, track)
-        k = len(self.graph) - 1
+        k = len(self._kf_front) - 1
         rel = relative(self._kf_front[k], pose)
         self._scan_kf.append(k)
         self._scan_rel.append(rel)
@@ -470,10 +547,10 @@ class GraphFastHoughSLAM:
 
     def _new_keyframe(self, pose, lines: list[Line], track) -> None:
         p = self.params
-        n = len(self.graph)
+        n = len(self._kf_front)
         if n == 0:
-            self.graph.add_node(pose)
             self._path.append(0.0)
+            self._in_turn(self._graph.add_node, pose)
         else:
             z = relative(self._kf_front[-1], pose)
             self._path.append(self._path[-1] + float(np.hypot(z[0], z[1])))
@@ -482,27 +559,65 @@ class GraphFastHoughSLAM:
             if track is not None and track.sure and not self._kf_doubt:
                 info = info + self._information(track.refinement, float(pose[2]))
             self._kf_doubt = False
-            self.graph.add_node(compose(self.graph.pose(n - 1), z))
-            self.graph.add_edge(n - 1, n, z, info)
-            if n >= 2:
-                self._close_loops(n - 1)
+            # Keyframe n-1 is complete: its cloud is thinned now, so that from here on the
+            # back end only reads it.
+            self._cloud(n - 1)
+            self._in_turn(self._add_keyframe, n, z, info)
         self._kf_front.append(pose.copy())
         self._clouds.append(np.zeros((0, 2)))
         self._normals.append(np.zeros((0, 2)))
         self._chunks.append([])
         self._kf_lines.append(lines)
 
+    # -- the back end: the graph, in turn (see _InOrder) ------------------------------------
+    def _in_turn(self, fn, *args) -> None:
+        """Run ``fn(*args)`` on the back end's thread after everything given before it (at
+        once without a background thread)."""
+        if not self._background:
+            fn(*args)
+            return
+        if self._worker is None:
+            self._worker = _InOrder()
+        self._worker.submit(fn, *args)
+
+    def sync(self) -> None:
+        """Wait until the back end has done everything given to it so far (and raise what
+        it raised)."""
+        if self._worker is not None:
+            self._worker.wait()
+
+    def _add_keyframe(self, n: int, z, info) -> None:
+        """Keyframe ``n`` at ``z`` from keyframe ``n - 1`` with ``info``; then look for
+        loops of keyframe ``n - 1``, which is complete."""
+        self._graph.add_node(compose(self._graph.pose(n - 1), z))
+        self._graph.add_edge(n - 1, n, z, info)
+        if n >= 2:
+            self._close_loops(n - 1)
+
+    @property
+    def graph(self) -> PoseGraph:
+        """The pose graph of the keyframes (once the back end has caught up)."""
+        self.sync()
+        return self._graph
+
+    @property
+    def loops(self) -> list[LoopClosure]:
+        """Every loop closure that entered the graph, in order (once the back end has caught
+        up); see :attr:`accepted_loops`."""
+        self.sync()
+        return self._loops
+
     def _submap(self, frame: int, members, poses=None) -> tuple[NDArray, NDArray]:
         """Points and normals of keyframes ``members`` in keyframe ``frame``'s frame (at
         ``poses``, default the graph's)."""
-        poses = self.graph.poses if poses is None else poses
+        poses = self._graph.poses if poses is None else poses
         return self._in_frame(poses, members, poses[frame])
 
     def _close_loops(self, i: int) -> None:
         p = self.params
         if p.loop_candidates == 0 or i <= p.loop_min_gap:
             return
-        poses = self.graph.poses
+        poses = self._graph.poses
         old = poses[: i - p.loop_min_gap + 1]
         drift = p.loop_growth * (self._path[i] - self._last_loop_path)
         radius = min(p.loop_max_radius, p.loop_radius + drift)
@@ -516,7 +631,7 @@ class GraphFastHoughSLAM:
         if len(query) < 10:
             return
         # Right after a loop closure the pose is known well: search a small window only.
-        tracking = bool(self.loops) and self.loops[-1].new == i - 1
+        tracking = bool(self._loops) and self._loops[-1].new == i - 1
         win = p.tracker.window if tracking else min(p.loop_max_window, p.loop_window + drift)
         win_deg = p.tracker.window_deg + 2 if tracking else p.loop_window_deg
         q_refine = voxel_downsample(query, 0.05)
@@ -560,12 +675,12 @@ class GraphFastHoughSLAM:
                 self._pending.append(h)
         if closed:
             self._last_loop_path = self._path[i]
-            if self.graph.chi2(np.array(closed)).max() >= p.loop_optimize_chi2:
+            if self._graph.chi2(np.array(closed)).max() >= p.loop_optimize_chi2:
                 self._optimize()
 
     def _add_loop(self, j: int, i: int, z, info, score: float) -> int:
-        e = self.graph.add_edge(j, i, z, info, self.params.loop_kernel, kind="loop")
-        self.loops.append(LoopClosure(j, i, z, score, e))
+        e = self._graph.add_edge(j, i, z, info, self.params.loop_kernel, kind="loop")
+        self._loops.append(LoopClosure(j, i, z, score, e))
         return e
 
     def _agree(self, g, h, poses) -> bool:
@@ -582,35 +697,41 @@ class GraphFastHoughSLAM:
     def _optimize(self) -> None:
         """Optimise; switch off loop edges that stay inconsistent, optimise again."""
         p = self.params
-        self.graph.optimize(p.optimize_iterations, p.optimize_tol)
-        active = [lc for lc in self.loops if self.graph.is_active(lc.edge)]
+        self._graph.optimize(p.optimize_iterations, p.optimize_tol)
+        active = [lc for lc in self._loops if self._graph.is_active(lc.edge)]
         if active:
-            chi2 = self.graph.chi2(np.array([lc.edge for lc in active]))
+            chi2 = self._graph.chi2(np.array([lc.edge for lc in active]))
             bad = [lc for lc, c in zip(active, chi2, strict=True) if c > p.loop_max_chi2]
             if bad:
                 for lc in bad:
-                    self.graph.set_active(lc.edge, False)
-                self.graph.optimize(p.optimize_iterations, p.optimize_tol)
-        self.loop_targets.drop_moved(self.graph.poses)
+                    self._graph.set_active(lc.edge, False)
+                self._graph.optimize(p.optimize_iterations, p.optimize_tol)
+        self.loop_targets.drop_moved(self._graph.poses)
 
     # -- results ---------------------------------------------------------------------------
     @property
     def accepted_loops(self) -> list[LoopClosure]:
         """The loop closures still in the graph (not switched off as inconsistent)."""
-        return [lc for lc in self.loops if self.graph.is_active(lc.edge)]
+        self.sync()
+        return [lc for lc in self._loops if self._graph.is_active(lc.edge)]
 
     @property
     def poses(self) -> NDArray[np.float64]:
         """Every scan's pose so far: its keyframe's graph pose ⊕ its pose relative to it."""
         if not self._scan_kf:
             return np.zeros((0, 3))
-        local = compose(self.graph.poses[np.array(self._scan_kf)], np.array(self._scan_rel))
+        self.sync()
+        local = compose(self._graph.poses[np.array(self._scan_kf)], np.array(self._scan_rel))
         return compose(self.origin, local)
 
     def finish(self) -> FinalEstimate:
         """Close the last keyframe (look for loops), optimise, and build the map from the
         keyframes at their optimised poses; every scan's pose is revised."""
-        n = len(self.graph)
+        self.sync()
+        if self._worker is not None:
+            self._worker.close()
+            self._worker = None
+        n = len(self._graph)
         if n >= 2:
             self._close_loops(n - 1)
             self._optimize()
@@ -623,10 +744,11 @@ class GraphFastHoughSLAM:
         fe = self.params.lines
         if self.origin is None:
             return []
+        self.sync()
         refs = ReferenceMap(
             fe.matching, fe.min_reference_length, fe.min_reference_points, fe.max_merge_residual
         )
-        for x, lines in zip(compose(self.origin, self.graph.poses), self._kf_lines, strict=True):
+        for x, lines in zip(compose(self.origin, self._graph.poses), self._kf_lines, strict=True):
             world = transform_lines(lines, x)
             refs.update(world, refs.associate(world, x))
         return refs.lines

@@ -19,7 +19,9 @@ import functools
 from dataclasses import dataclass
 
 import numpy as np
-from numba import njit
+from llvmlite import ir
+from numba import njit, types
+from numba.core.extending import intrinsic
 from numpy.typing import ArrayLike, NDArray
 from scipy.spatial import cKDTree
 
@@ -977,26 +979,106 @@ def refine(
         raise ValueError(f"max_distance must be > 0, got {max_distance}")
     if len(target.points) == 0 or iterations < 1:
         return Refinement(x, np.zeros((3, 3)), 0, 0.0)
-    q0 = np.ascontiguousarray(q0)
     nx, ny = target.shape
+    if prior is None:
+        prior_pose, prior_info = np.zeros(3), np.zeros((3, 3))
+    x, h, n_ok, rms = _gauss_newton(
+        np.ascontiguousarray(q0), x, target.points, target.normals, target.origin,
+        target.cell, nx, ny, target.starts, target.order, float(max_distance), float(huber),
+        int(iterations), float(min_eigen_ratio), prior is not None,
+        np.ascontiguousarray(prior_pose), np.ascontiguousarray(prior_info),
+    )  # fmt: skip
+    return Refinement(x, h, int(n_ok), float(rms))
+
+
+@intrinsic
+def _fma(typingctx, a, b, c):  # pragma: no cover (compiled)
+    """``a * b + c`` rounded once (LLVM's ``llvm.fma``: one instruction where the CPU has
+    it, else a correctly rounded library call)."""
+    sig = types.float64(types.float64, types.float64, types.float64)
+
+    def codegen(context, builder, signature, args):
+        d = ir.DoubleType()
+        fn = builder.module.declare_intrinsic("llvm.fma", [d], ir.FunctionType(d, [d, d, d]))
+        return builder.call(fn, args)
+
+    return sig, codegen
+
+
+@njit(cache=True, nogil=True)
+def _dot_rows(a, x):  # pragma: no cover
+    """``a @ x`` rounded as NumPy's ``@`` is for a C-ordered ``a``: OpenBLAS's transposed
+    matrix-vector kernel (x86-64) forms each row's dot product as the second product, then
+    fused multiply-adds of the first, the third, ..."""
+    out = np.empty(a.shape[0])
+    for i in range(a.shape[0]):
+        if a.shape[1] == 1:
+            out[i] = a[i, 0] * x[0]
+            continue
+        s = _fma(a[i, 0], x[0], a[i, 1] * x[1])
+        for j in range(2, a.shape[1]):
+            s = _fma(a[i, j], x[j], s)
+        out[i] = s
+    return out
+
+
+@njit(cache=True, nogil=True)
+def _dot_columns(a, x):  # pragma: no cover
+    """``a @ x`` rounded as NumPy's ``@`` is for a Fortran-ordered ``a`` (what a boolean
+    selection of columns gives): OpenBLAS's kernel adds column after column, each by a fused
+    multiply-add."""
+    out = np.empty(a.shape[0])
+    for i in range(a.shape[0]):
+        s = a[i, 0] * x[0]
+        for j in range(1, a.shape[1]):
+            s = _fma(a[i, j], x[j], s)
+        out[i] = s
+    return out
+
+
+@njit(cache=True, nogil=True)
+def _gauss_newton(
+    q0,
+    x,
+    pts,
+    nrm,
+    lo,
+    cell,
+    nx,
+    ny,
+    starts,
+    order,
+    max_d,
+    huber,
+    iterations,
+    min_eigen_ratio,
+    use_prior,
+    prior_pose,
+    prior_info,
+):  # pragma: no cover
+    """The rounds of :func:`refine`, compiled: each pairs the points (:func:`_accumulate`)
+    and takes a Gauss-Newton step, rounded as the NumPy code it replaces, bit for bit
+    (LAPACK's solve and symmetric eigensolver; the products as :func:`_dot_rows` and
+    :func:`_dot_columns`). Returns
+    ``(pose, H, pairs, rms)``."""
     h, n_ok, rms = np.zeros((3, 3)), 0, 0.0
     for it in range(iterations):
         h, g, n_ok, ss = _accumulate(
-            q0, x[0], x[1], x[2], target.points, target.normals, target.origin, target.cell,
-            nx, ny, target.starts, target.order, float(max_distance), float(huber),
-        )  # fmt: skip
+            q0, x[0], x[1], x[2], pts, nrm, lo, cell, nx, ny, starts, order, max_d, huber
+        )
         if n_ok < 10:
-            return Refinement(x, np.zeros((3, 3)), n_ok, 0.0)
-        rms = float(np.sqrt(ss / n_ok))
+            return x, np.zeros((3, 3)), n_ok, 0.0
+        rms = np.sqrt(ss / n_ok)
         if it == iterations - 1:
             break
-        if prior is not None:
+        if use_prior:
             dp = x - prior_pose
             dp[2] = np.arctan2(np.sin(dp[2]), np.cos(dp[2]))
-            delta = -np.linalg.solve(h + prior_info, g + prior_info @ dp)
+            delta = -np.linalg.solve(h + prior_info, g + _dot_rows(prior_info, dp))
         else:
             evals, evecs = np.linalg.eigh(h)
             keep = evals > min_eigen_ratio * max(evals[-1], 1e-12)
-            delta = -(evecs[:, keep] @ ((evecs[:, keep].T @ g) / evals[keep]))
+            v = evecs[:, keep]  # NumPy's is Fortran-ordered, its transpose C-ordered
+            delta = -_dot_columns(v, _dot_rows(np.ascontiguousarray(v.T), g) / evals[keep])
         x = x + delta  # no early stop: runs that differ in the last bit stay that close
-    return Refinement(x, h, n_ok, rms)
+    return x, h, n_ok, rms

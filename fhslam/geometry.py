@@ -9,6 +9,7 @@ line is ``rho = x cos(theta) + y sin(theta)`` (paper eq. (1)) with ``rho >= 0`` 
 from __future__ import annotations
 
 import numpy as np
+from numba import njit
 from numpy.typing import ArrayLike, NDArray
 
 TWO_PI = 2.0 * np.pi
@@ -43,6 +44,8 @@ def as_points(points: ArrayLike, name: str = "points") -> NDArray[np.float64]:
     p = np.asarray(points, dtype=float)
     if p.ndim != 2 or p.shape[1] != 2:
         raise ValueError(f"{name} must have shape (N, 2), got shape {p.shape}")
+    if np.isfinite(p).all():  # one pass over the flat array: the common case
+        return p
     bad = ~np.isfinite(p).all(axis=1)
     if bad.any():
         i = int(np.flatnonzero(bad)[0])
@@ -126,7 +129,20 @@ def transform_points(pose: ArrayLike, points: ArrayLike) -> NDArray[np.float64]:
     x, y, th = np.asarray(pose, dtype=float)
     p = np.asarray(points, dtype=float)
     c, s = np.cos(th), np.sin(th)
+    if p.ndim == 2 and p.shape[1] >= 2:
+        return _transform(p, float(x), float(y), float(c), float(s))
     return np.column_stack([x + c * p[:, 0] - s * p[:, 1], y + s * p[:, 0] + c * p[:, 1]])
+
+
+@njit(cache=True, nogil=True)
+def _transform(p, x, y, c, s):  # pragma: no cover
+    """:func:`transform_points`' arithmetic, point by point in one pass (the same operations
+    in the same order as the NumPy expression: the same bits)."""
+    out = np.empty((p.shape[0], 2))
+    for k in range(p.shape[0]):
+        out[k, 0] = x + c * p[k, 0] - s * p[k, 1]
+        out[k, 1] = y + s * p[k, 0] + c * p[k, 1]
+    return out
 
 
 def polar_to_points(ranges: ArrayLike, angles: ArrayLike) -> NDArray[np.float64]:

@@ -761,3 +761,16 @@ def test_dot_products_are_numpys_products_to_the_last_bit_or_two():
             f = np.asfortranarray(a)
             close(_dot_columns(f, x), f @ x, a, x)
             close(_dot_rows(np.ascontiguousarray(a.T), y), a.T @ y, a.T, y)
+
+
+def test_transform_points_equals_the_numpy_expression_bit_for_bit(paper_scans):
+    from fhslam.geometry import transform_points
+
+    rng = np.random.default_rng(6)
+    clouds = [*paper_scans[:10], np.zeros((0, 2)), rng.normal(0, 1e6, (50, 2))]
+    clouds.append(rng.normal(0, 1, (40, 3))[:, :2])  # a strided view
+    for p in clouds:
+        x, y, th = rng.normal(0, [5, 5, 2])
+        c, s = np.cos(th), np.sin(th)
+        want = np.column_stack([x + c * p[:, 0] - s * p[:, 1], y + s * p[:, 0] + c * p[:, 1]])
+        assert_identical(transform_points([x, y, th], p), want)

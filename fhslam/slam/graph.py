@@ -339,7 +339,7 @@ class _InOrder:
     called or this object is collected.
     """
 
-    def __init__(self, max_queued: int = 32):
+    def __init__(self, max_queued: int = 256):
         self._queue: queue.Queue = queue.Queue(max_queued)
         self._failed: list[BaseException] = []
         thread = threading.Thread(

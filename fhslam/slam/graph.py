@@ -47,6 +47,7 @@ results are the same bit for bit (``background=False`` runs it in turn).
 
 from __future__ import annotations
 
+import contextlib
 import queue
 import threading
 import weakref
@@ -346,7 +347,14 @@ class _InOrder:
             target=_InOrder._serve, args=(self._queue, self._failed), daemon=True
         )
         thread.start()
-        weakref.finalize(self, self._queue.put, None)
+        weakref.finalize(self, _InOrder._stop, self._queue)
+
+    @staticmethod
+    def _stop(jobs: queue.Queue) -> None:
+        # Never blocks: at interpreter exit (Ctrl-C while the back end is behind) the queue
+        # may be full, and the thread is a daemon then anyway.
+        with contextlib.suppress(queue.Full):
+            jobs.put_nowait(None)
 
     @staticmethod
     def _serve(jobs: queue.Queue, failed: list[BaseException]) -> None:
@@ -373,7 +381,7 @@ class _InOrder:
 
     def close(self) -> None:
         """Let the thread end once the calls given so far have run."""
-        self._queue.put(None)
+        _InOrder._stop(self._queue)
 
     def _raise(self) -> None:
         if self._failed:

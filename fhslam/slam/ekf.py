@@ -43,10 +43,9 @@ import functools
 import warnings
 from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import ParamSpec, TypeVar
+from typing import TYPE_CHECKING, ParamSpec, TypeVar
 
 import numpy as np
-from filterpy.kalman import ExtendedKalmanFilter
 from numpy.typing import ArrayLike, NDArray
 from threadpoolctl import ThreadpoolController
 
@@ -63,6 +62,9 @@ from fhslam.geometry import (
 from fhslam.lines import Line
 from fhslam.scan import Scan
 from fhslam.slam.base import FinalEstimate, StepResult
+
+if TYPE_CHECKING:
+    from filterpy.kalman import ExtendedKalmanFilter
 
 __all__ = [
     "CHI2_2DOF_99",
@@ -201,7 +203,8 @@ _T = TypeVar("_T")
 @functools.cache
 def _blas_pools() -> ThreadpoolController:
     """The process's BLAS thread pools, found once (finding them takes about 1 ms, a limit
-    with them 0.02 ms); numpy's and scipy's (which filterpy uses) are loaded by then."""
+    with them 0.02 ms), after filterpy has loaded scipy's, which it uses besides numpy's."""
+    _motion_ekf()
     return ThreadpoolController()
 
 
@@ -217,11 +220,19 @@ def _one_blas_thread(method: Callable[_P, _T]) -> Callable[_P, _T]:
     return limited
 
 
-class _MotionEKF(ExtendedKalmanFilter):
-    """filterpy's EKF with the nonlinear motion ``x ⊕ u`` for the robot part of the state."""
+@functools.cache
+def _motion_ekf() -> type[ExtendedKalmanFilter]:
+    """filterpy's EKF with the nonlinear motion ``x ⊕ u`` for the robot part of the state.
 
-    def predict_x(self, u=0):
-        self.x[:3] = compose(self.x[:3], u)
+    Made on first use: filterpy imports ``scipy.stats`` (0.35 s), which only this baseline
+    needs, so ``fhslam slam`` with another method starts that much sooner."""
+    from filterpy.kalman import ExtendedKalmanFilter
+
+    class _MotionEKF(ExtendedKalmanFilter):
+        def predict_x(self, u=0):
+            self.x[:3] = compose(self.x[:3], u)
+
+    return _MotionEKF
 
 
 # --------------------------------------------------------------------------- the filter
@@ -236,7 +247,7 @@ class EKFLineSLAM:
 
     def __init__(self, params: EKFParams | None = None, initial_pose: ArrayLike | None = None):
         self.params = params or EKFParams()
-        self.ekf: _MotionEKF | None = None
+        self.ekf: ExtendedKalmanFilter | None = None
         self.anchor: NDArray[np.float64] | None = None
         self._init_pose = None if initial_pose is None else as_pose(initial_pose)
         self._last_odometry: NDArray | None = None
@@ -255,7 +266,7 @@ class EKFLineSLAM:
 
     def _start(self, pose: NDArray) -> None:
         self.anchor = pose.astype(float).copy()
-        self.ekf = _MotionEKF(dim_x=3, dim_z=2)
+        self.ekf = _motion_ekf()(dim_x=3, dim_z=2)
         self.ekf.x = np.zeros(3)  # the anchor frame's origin
         self.ekf.P = np.eye(3) * 1e-9  # "suppose the initial localization is correct"
 
@@ -269,7 +280,7 @@ class EKFLineSLAM:
         """
         old = self.ekf
         n = old.dim_x
-        new = _MotionEKF(dim_x=n + 2, dim_z=2)
+        new = _motion_ekf()(dim_x=n + 2, dim_z=2)
         new.x = np.concatenate([old.x, landmark])
         p = np.zeros((n + 2, n + 2))
         p[:n, :n] = old.P

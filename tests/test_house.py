@@ -49,6 +49,20 @@ def test_import_fhslam_is_lazy():
     assert after == "True"
 
 
+def test_only_the_ekf_baseline_loads_filterpy():
+    """filterpy imports ``scipy.stats`` (0.35 s of every command's start): the pipeline and
+    the command load it only when the EKF baseline runs."""
+    code = (
+        "import sys\n"
+        "import fhslam.cli, fhslam.pipeline, fhslam.slam\n"
+        "print('filterpy' in sys.modules, 'scipy.stats' in sys.modules)\n"
+        "fhslam.pipeline.make_backend('ekf')._start(fhslam.geometry.as_pose([0, 0, 0]))\n"
+        "print('filterpy' in sys.modules)\n"
+    )
+    r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert r.stdout.splitlines() == ["False False", "True"]
+
+
 def test_public_api_names_resolve_and_unknown_names_fail():
     assert 20 <= len(fhslam.__all__) <= 35
     for name in fhslam.__all__:

@@ -264,9 +264,9 @@ graph_summary(graph, res_graph)
 # | Cartographer | 0.0229 ± 0.0239 | Hess et al. 2016, Table II |
 #
 # The paper's procedure reduces the odometry's 7.4 m to 2.8 m but stays at metres: globally it is
-# not a usable map. The graph method brings Intel to 0.014 ± 0.012 m and 0.22°, with 649 loop
-# closures active in the end (of 650 accepted; the run switches off the one it finds
-# inconsistent). That is below the published graph-mapping and Cartographer numbers — but read it
+# not a usable map. The graph method brings Intel to 0.014 ± 0.012 m and 0.23°, with 623 loop
+# closures, all still active in the end (the run switches off any it finds inconsistent after
+# optimising). That is below the published graph-mapping and Cartographer numbers — but read it
 # with two caveats: Intel is a *development* log, the defaults were developed on it; and the
 # published numbers come from other implementations on other machines.
 

@@ -56,6 +56,8 @@ def test_tracker_parameters_are_checked():
         TrackerParams(prior_sigma=(0.05, 0.0))
     with pytest.raises(ValueError, match="residual_sigma must be > 0"):
         TrackerParams(residual_sigma=-1.0)
+    with pytest.raises(ValueError, match="refine_iterations must be >= 1"):
+        TrackerParams(refine_iterations=0)
 
 
 def _room_points(step=0.02):

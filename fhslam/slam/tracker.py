@@ -90,6 +90,11 @@ class TrackerParams:
         ... and to at most this many points.
     refine_distance : float
         Point-to-line pairs farther apart than this (metres) are not formed.
+    refine_iterations : int
+        Rounds of the refinement (each pairs every point anew and takes a Gauss-Newton
+        step; the last only measures). The four steps that ten rounds added moved a pose by
+        0.35, 0.24, 0.18 and 0.11 mm (medians on MIT CSAIL), under the spread of the map's
+        own points; with six no relation error on the shared logs changed by more than 2 %.
     prior_sigma : (float, float)
         The odometry prediction enters the refinement as a prior of this standard deviation
         (metres, degrees), relative to a point-to-line residual of ``residual_sigma``: where
@@ -114,6 +119,7 @@ class TrackerParams:
     query_voxel: float = 0.05
     max_points: int = 250
     refine_distance: float = 0.15
+    refine_iterations: int = 6
     prior_sigma: tuple[float, float] = (0.05, 10.0)
     residual_sigma: float = 0.03
 
@@ -124,6 +130,10 @@ class TrackerParams:
         if not (len(self.prior_sigma) == 2 and all(v > 0 for v in self.prior_sigma)):
             raise ValueError(
                 f"TrackerParams.prior_sigma must be two values > 0, got {self.prior_sigma}"
+            )
+        if self.refine_iterations < 1:
+            raise ValueError(
+                f"TrackerParams.refine_iterations must be >= 1, got {self.refine_iterations}"
             )
         if not self.residual_sigma > 0:
             raise ValueError(f"TrackerParams.residual_sigma must be > 0, got {self.residual_sigma}")
@@ -248,7 +258,7 @@ class ScanTracker:
         info = p.residual_sigma**2 * np.diag([1 / s_xy**2, 1 / s_xy**2, 1 / np.radians(s_deg) ** 2])
         # after a glitch (recovered) the prediction is wrong: no prior then
         prior = None if recovered else (predicted, info)
-        ref = refine(target, points, pose, p.refine_distance, prior=prior)
+        ref = refine(target, points, pose, p.refine_distance, p.refine_iterations, prior=prior)
         if ref.n_matched >= 10 and np.hypot(*(ref.pose[:2] - pose[:2])) <= p.window:
             pose = ref.pose
         self._doubt = score < p.sure_score

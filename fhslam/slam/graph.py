@@ -16,7 +16,10 @@ line describes. What this module adds, each measured in the README:
 3. **Edges weighted by their information.** An edge between consecutive keyframes carries
    the point-to-line refinement's information (its 3 x 3 Hessian, scaled to
    ``edge_points`` independent points of ``edge_sigma``) plus a weak odometry prior; in a
-   corridor the scan constrains nothing along the axis and the edge says so.
+   corridor the scan constrains nothing along the axis and the edge says so. An edge across
+   a doubtful scan carries the odometry alone: its information and its measurement, the
+   odometry's motion between the two keyframes (not the doubtful track's), unless the
+   odometry glitched on the way.
 4. **Verified loop closures.** A completed keyframe is matched (correlative search, then
    point-to-line refinement) against up to ``loop_candidates`` old keyframes near it; the
    search radius and window grow with the distance travelled since the last closure. A
@@ -430,6 +433,7 @@ class GraphFastHoughSLAM:
         self._pose: NDArray[np.float64] | None = None
         self._last_odometry: NDArray[np.float64] | None = None
         self._kf_front: list[NDArray[np.float64]] = []  # keyframe poses, tracking frame
+        self._kf_odometry: list[NDArray[np.float64]] = []  # the odometry at each keyframe
         self._clouds: list[NDArray[np.float64]] = []
         self._normals: list[NDArray[np.float64]] = []  # each cloud point's normal or NaN
         self._chunks: list[list[tuple[NDArray, NDArray]]] = []  # scans not yet thinned in
@@ -440,6 +444,7 @@ class GraphFastHoughSLAM:
         self._pending: list[tuple[int, int, NDArray, NDArray, float, NDArray]] = []
         self._failed: dict[int, int] = {}  # candidate -> the last keyframe it failed for
         self._kf_doubt = False  # whether a scan since the last keyframe was doubtful
+        self._kf_glitch = False  # whether the odometry glitched since the last keyframe
         self._scan_kf: list[int] = []
         self._scan_rel: list[NDArray[np.float64]] = []
         self.loop_targets = LoopTargetCache()
@@ -467,7 +472,12 @@ class GraphFastHoughSLAM:
             self.origin = odometry.copy() if self._initial is None else self._initial.copy()
             pose = np.zeros(3)
         else:
-            predicted = compose(self._pose, relative(self._last_odometry, odometry))
+            step = relative(self._last_odometry, odometry)
+            t = p.tracker
+            self._kf_glitch = self._kf_glitch or bool(
+                np.hypot(step[0], step[1]) > t.max_step or abs(np.degrees(step[2])) > t.max_turn_deg
+            )
+            predicted = compose(self._pose, step)
             pose = predicted
             if pts is not None and len(pts) >= 10:
                 track = self.tracker.track(pts, predicted, self._pose)
@@ -490,7 +500,7 @@ class GraphFastHoughSLAM:
                     if fe.extractor
                     else extract_lines(all_points, fe.extraction)
                 )
-            self._new_keyframe(pose, lines, track)
+            self._new_keyframe(pose, lines, track, odometry)
         k = len(self._kf_front) - 1
         rel = relative(self._kf_front[k], pose)
         self._scan_kf.append(k)
@@ -555,7 +565,9 @@ class GraphFastHoughSLAM:
         h = ref.hessian * (p.edge_points / (ref.n_matched * p.edge_sigma**2))
         return _rotate_information(h, theta)
 
-    def _new_keyframe(self, pose, lines: list[Line], track) -> None:
+    def _new_keyframe(self, pose, lines: list[Line], track, odometry) -> None:
+        """Start a keyframe at ``pose`` (tracking frame; ``odometry``: the odometry there) and
+        give the graph its edge from the previous one."""
         p = self.params
         n = len(self._kf_front)
         if n == 0:
@@ -568,12 +580,18 @@ class GraphFastHoughSLAM:
             info = np.diag([1 / s_xy**2, 1 / s_xy**2, 1 / np.radians(s_deg) ** 2])
             if track is not None and track.sure and not self._kf_doubt:
                 info = info + self._information(track.refinement, float(pose[2]))
-            self._kf_doubt = False
+            elif not self._kf_glitch:
+                # The edge carries the odometry's information only: so its measurement is the
+                # odometry's too. A doubtful track can be placed far off an odometry that
+                # hardly turns (Freiburg hospital, among people: 7-15 degrees at one scan).
+                z = relative(self._kf_odometry[-1], odometry)
+            self._kf_doubt = self._kf_glitch = False
             # Keyframe n-1 is complete: its cloud is thinned now, so that from here on the
             # back end only reads it.
             self._cloud(n - 1)
             self._in_turn(self._add_keyframe, n, z, info)
         self._kf_front.append(pose.copy())
+        self._kf_odometry.append(odometry.copy())
         self._clouds.append(np.zeros((0, 2)))
         self._normals.append(np.zeros((0, 2)))
         self._chunks.append([])

@@ -251,13 +251,12 @@ def test_bad_parameters_are_named(field, value, message):
 
 CLINIC = (
     "Freiburg hospital: the return to the start after 6300 scans is not closed. The robot "
-    "comes back facing the other way, so its 180-degree laser sees the other side of the "
+    "comes back turned by 56-180 degrees, so its 180-degree laser sees other sides of the "
     "corridors: at the true relative pose the return's queries score 0.01-0.52 against the "
-    "start's keyframes (a closure needs 0.55), and the estimate there is 20-41 m and 12-23 "
-    "degrees off (over scans 5700-6000, in open halls, even scan-to-scan matching turns 0.04 "
-    "degrees per scan more than the odometry, which the relations bear out). The mean is 1-5 "
-    "m; the 2642 "
-    "relations under a minute average 0.094 m (odometry 0.077 m)"
+    "keyframes they revisit (a closure needs 0.55), and the estimate there is 20-41 m and "
+    "12-23 degrees off (over scans 5700-6000, in open halls, even scan-to-scan matching "
+    "turns 0.04 degrees per scan more than the odometry, which the relations bear out). The "
+    "mean is 1-5 m; the 2642 relations under a minute average 0.094 m (odometry 0.077 m)"
 )
 
 

@@ -364,8 +364,8 @@ MOUNT_NOTES = {
     "fr079": (
         "the original CARMEN log states PARAM robot_frontlaser_offset -0.04 (the laser 4 cm "
         "behind the robot's centre); its bag's /tf_static publishes +0.04. The relations "
-        "decide: the default SLAM gives 0.0303 m with -0.04, 0.0406 m with 0 and 0.0643 m "
-        "with +0.04 (10 % of the scans dropped: 0.0306 m with -0.04, 0.0403 m with +0.04)"
+        "decide: the default SLAM gives 0.0301 m with -0.04, 0.0408 m with 0 and 0.0636 m "
+        "with +0.04 (10 % of the scans dropped: 0.0308 m with -0.04, 0.0630 m with +0.04)"
     ),
 }
 """Why a dataset's :attr:`Dataset.laser_offset` overrides its log file's statement."""

@@ -199,7 +199,7 @@ def test_an_interlaced_laser_gets_per_scan_bearing_offsets(tmp_path):
 def test_fr079_loaded_as_a_dataset_gets_its_original_mount(real_data, tmp_path):
     """The bag publishes base_link -> laser x = +0.04 m; the original CARMEN log states
     ``robot_frontlaser_offset -0.04`` (issue 10, item 4). The relations side with the log
-    (default SLAM: 0.0303 m with -0.04 against 0.0643 m with +0.04), so the dataset loader
+    (default SLAM: 0.0301 m with -0.04 against 0.0636 m with +0.04), so the dataset loader
     corrects the mount of the dataset's file, found by name or by file name and size; the
     reader reports the file as it is, and any other file keeps its own mount."""
     import shutil

@@ -280,7 +280,12 @@ def _slam(args: argparse.Namespace) -> None:
             "graph (nothing was written)"
         )
     check_outputs(
-        {"--trajectory": args.trajectory, "--map": args.map, "--graph": args.graph},
+        {
+            "--trajectory": args.trajectory,
+            "--map": args.map,
+            "--graph": args.graph,
+            "--plot": args.plot,
+        },
         {"the input log": args.log},
     )
     with _profiling(args.profile):
@@ -294,7 +299,7 @@ def _slam(args: argparse.Namespace) -> None:
             )
         progress = not args.quiet and len(log) > 200
         graph = None
-        if args.graph is None:
+        if args.method != "graph" or (args.graph is None and args.plot is None):
             result = run_slam(log, args.method, progress=progress)
         else:
             backend = make_backend(args.method)
@@ -313,13 +318,34 @@ def _slam(args: argparse.Namespace) -> None:
             if args.map is not None:
                 write_map(args.map, result.map)
                 wrote.append(f"{len(result.map)} map lines to {args.map}")
-            if graph is not None:
+            if args.graph is not None:
                 write_graph(args.graph, graph)
                 wrote.append(
                     f"{len(graph)} keyframes and {len(graph.active)} loop closures "
                     f"({graph.n_active} active) to {args.graph}"
                 )
+            if args.plot is not None:
+                _write_plot(args.plot, log, result, args.method, graph)
+                wrote.append(f"a picture of the run to {args.plot}")
         print("wrote " + ", ".join(wrote[:-1]) + (" and " if len(wrote) > 1 else "") + wrote[-1])
+
+
+def _write_plot(path: Path, log, result, method: str, graph) -> None:
+    """Draw the run (:func:`fhslam.figures.slam_run_figure`) into the PNG ``path``."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from fhslam.figures import slam_run_figure
+    from fhslam.io.files import atomic_output
+
+    fig = slam_run_figure(log, result, method, graph)
+    try:
+        with atomic_output(path, "wb") as f:
+            fig.savefig(f, format="png", dpi=100, bbox_inches="tight", metadata={"Software": None})
+    finally:
+        plt.close(fig)
 
 
 def _bench(args: argparse.Namespace) -> None:
@@ -484,6 +510,12 @@ def build_parser() -> argparse.ArgumentParser:
         help="output keyframe-graph JSON (--method graph only): each keyframe's timestamp and "
         "world-frame pose, each accepted loop closure's keyframes, score and whether it is "
         "still active",
+    )
+    p.add_argument(
+        "--plot",
+        type=Path,
+        help="output PNG: the map, the trajectory and the odometry (the truth where the log "
+        "has it; a graph run's loop closures)",
     )
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.add_argument("--profile", action="store_true", help=PROFILE_HELP)

@@ -394,6 +394,42 @@ def test_slam_graph_writes_the_keyframes_and_loop_closures(tmp_path, capsys):
     np.testing.assert_array_equal(read_trajectory(tmp_path / "u.txt")[1], poses)
 
 
+def test_slam_plot_writes_a_picture_of_the_run(tmp_path, capsys):
+    """``--plot PNG``: a picture of the run, written with the other outputs (what it shows:
+    ``tests/test_figures.py``); the trajectory is the one without ``--plot``."""
+    import matplotlib.image
+
+    log, _ = _simulate_drifting(tmp_path, "random:105")
+    capsys.readouterr()
+    for method in ("graph", "fht"):
+        traj, png = tmp_path / f"{method}.txt", tmp_path / f"{method}.png"
+        argv = ["slam", str(log), "--method", method, "--trajectory", str(traj), "--plot",
+                str(png), "--quiet"]  # fmt: skip
+        assert main(argv) == 0
+        n = len(read_trajectory(traj)[0])
+        assert capsys.readouterr().out == (
+            f"wrote {n} poses to {traj} and a picture of the run to {png}\n"
+        )
+        assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+        image = matplotlib.image.imread(png)
+        assert image.ndim == 3 and image.shape[0] > 400 and image.shape[1] > 400
+        assert image[..., :3].std() > 0.05  # not a blank page
+        plain = tmp_path / f"{method}_plain.txt"
+        assert (
+            main(["slam", str(log), "--method", method, "--trajectory", str(plain), "--quiet"]) == 0
+        )
+        np.testing.assert_array_equal(read_trajectory(plain)[1], read_trajectory(traj)[1])
+        capsys.readouterr()
+
+
+def test_slam_plot_into_a_missing_folder_writes_nothing(short_clf, tmp_path):
+    traj, png = tmp_path / "t.txt", tmp_path / "no" / "such" / "run.png"
+    r = run("slam", str(short_clf), "--trajectory", str(traj), "--plot", str(png))
+    assert r.returncode == 2 and r.stdout == "" and "--plot" in r.stderr and str(png) in r.stderr
+    assert len(r.stderr.strip().splitlines()) == 1  # one line, no traceback
+    assert list(tmp_path.iterdir()) == []  # not even the trajectory
+
+
 @pytest.mark.parametrize("method", ["fht", "odometry"])
 def test_slam_graph_is_refused_for_a_method_without_one(short_clf, tmp_path, method):
     traj, graph = tmp_path / "t.txt", tmp_path / "g.json"

@@ -142,3 +142,46 @@ def test_plot_lines_and_trajectory_take_matplotlib_aliases():
     plot_trajectory(np.zeros((3, 3)), ax=ax, lw=0.3)
     assert ax.lines[-1].get_linewidth() == 0.3
     plt.close(fig)
+
+
+def test_a_slam_run_figure_shows_the_run_its_closures_and_not_the_odometrys_drift():
+    """:func:`fhslam.figures.slam_run_figure` (``fhslam slam --plot``): the map, the run, the
+    truth with its ATE in the title, each loop closure still in the graph as a segment between
+    its two keyframes; the view holds the run and the true walls, not the odometry's metres of
+    drift."""
+    from dataclasses import replace
+
+    from matplotlib.collections import LineCollection
+    from matplotlib.colors import to_rgba
+
+    from fhslam.pipeline import keyframe_graph, make_backend, run_backend
+    from fhslam.sim import OdometryNoise, load_world, simulate
+
+    log = simulate(load_world("random:105"), seed=0, odometry=OdometryNoise.drifting(), laps=2)
+    backend = make_backend("graph")
+    result = run_backend(backend, log)
+    graph = keyframe_graph(backend, log)
+    # drawn with an odometry that drifts 40 m along x (the SLAM ran on the log's own)
+    drifted = log.odometry + np.linspace(0, 40, len(log))[:, None] * [1, 0, 0]
+    fig = figures.slam_run_figure(replace(log, odometry=drifted), result, "graph", graph)
+    ax = fig.axes[0]
+    kept = graph.loops[graph.active]
+    labels = ax.get_legend_handles_labels()[1]
+    assert len(kept) > 5 and f"{len(kept)} loop closures" in labels
+    assert {"odometry", "truth", "graph", f"map ({len(result.map)} reference lines)"} <= set(labels)
+    green = [
+        c
+        for c in ax.collections
+        if isinstance(c, LineCollection) and np.allclose(c.get_colors()[0], to_rgba("tab:green"))
+    ]
+    assert len(green) == 1
+    np.testing.assert_allclose(np.array(green[0].get_segments()), graph.poses[kept][:, :, :2])
+    ate = np.sqrt(np.mean(np.sum((result.poses[:, :2] - log.truth[:, :2]) ** 2, axis=1)))
+    assert ax.get_title() == (
+        f"random:105: graph, {len(log)} scans, ATE {ate:.3f} m, {len(graph)} keyframes"
+    )
+    (x0, x1), (y0, y1) = ax.get_xlim(), ax.get_ylim()
+    inside = lambda p: (x0 <= p[:, 0]) & (p[:, 0] <= x1) & (y0 <= p[:, 1]) & (p[:, 1] <= y1)  # noqa: E731
+    assert inside(result.poses).all() and inside(np.reshape(log.world.walls, (-1, 2))).all()
+    assert x1 - x0 < 25 and not inside(drifted).all()  # the world's 14 m, not the drift's 40
+    plt.close(fig)

@@ -40,7 +40,12 @@ from fhslam.figures.scenes import (
     similarity_examples,
     slam_log,
 )
-from fhslam.figures.slam import fig12_pioneer, fig13_environment_map, fig14_slam_result
+from fhslam.figures.slam import (
+    fig12_pioneer,
+    fig13_environment_map,
+    fig14_slam_result,
+    slam_run_figure,
+)
 
 __all__ = [
     "SEED",
@@ -65,4 +70,5 @@ __all__ = [
     "reproduce",
     "similarity_examples",
     "slam_log",
+    "slam_run_figure",
 ]

@@ -1,13 +1,15 @@
-"""Figures 12-14: the robot, the map it builds and the SLAM result (Loop 3)."""
+"""Figures 12-14: the robot, the map it builds and the SLAM result (Loop 3); and the picture
+of a SLAM run on any log that ``fhslam slam --plot`` writes (:func:`slam_run_figure`)."""
 
 from __future__ import annotations
 
 import matplotlib.pyplot as plt
 import numpy as np
+from matplotlib.collections import LineCollection
 from matplotlib.figure import Figure
 
 from fhslam import plotting
-from fhslam.io import Log
+from fhslam.io import KeyframeGraph, Log
 from fhslam.pipeline import SlamResult
 from fhslam.sim import World, paper_world
 
@@ -97,4 +99,70 @@ def fig14_slam_result(log: Log, result: SlamResult) -> Figure:
         f"(odometry {np.sqrt(np.mean(odo**2)):.2f} m), {len(result.map)} map lines"
     )
     ax.legend(loc="upper right", fontsize=9)
+    return fig
+
+
+def slam_run_figure(
+    log: Log, result: SlamResult, method: str, graph: KeyframeGraph | None = None
+) -> Figure:
+    """A SLAM run on any log, as ``fhslam slam --plot`` draws it: the map of reference lines,
+    the estimated trajectory from S to E and the odometry (dead reckoning from the same first
+    pose; the view is the run's, so a drift of tens of metres leaves it), the
+    true walls and trajectory where the log has them, and for a graph run each loop closure
+    still in the graph as a thin line between its two keyframes.
+
+    Parameters
+    ----------
+    log : Log
+        The log the run was made on.
+    result : SlamResult
+        The run (:func:`fhslam.pipeline.run_slam`).
+    method : str
+        The method's name, for the title and the legend.
+    graph : KeyframeGraph, optional
+        The run's keyframes and loop closures (:func:`fhslam.pipeline.keyframe_graph`).
+    """
+    fig, ax = plt.subplots(figsize=(10, 7.5))
+    if log.world is not None:
+        plotting.plot_walls(log.world.walls, ax=ax, colors="0.8", linewidths=4, label="true walls")
+    plotting.plot_lines(
+        result.map,
+        ax=ax,
+        linewidth=1.2,
+        markers=False,
+        label=f"map ({len(result.map)} reference lines)",
+    )
+    plotting.plot_trajectory(
+        log.odometry, ax=ax, color="tab:orange", linewidth=0.8, label="odometry"
+    )
+    title = f"{log.name or 'log'}: {method}, {len(log)} scans"
+    if log.truth is not None:
+        plotting.plot_trajectory(log.truth, ax=ax, color="k", ls="--", label="truth")
+        err = np.hypot(*(result.poses[:, :2] - log.truth[:, :2]).T)
+        title += f", ATE {np.sqrt(np.mean(err**2)):.3f} m"
+    plotting.plot_trajectory(result.poses, ax=ax, color="tab:blue", linewidth=1.0, label=method)
+    if graph is not None:
+        kept = graph.loops[graph.active]
+        if len(kept):
+            ends = graph.poses[kept][:, :, :2]  # (L, 2 keyframes, xy)
+            ax.add_collection(LineCollection(ends, colors="tab:green", linewidths=0.6, zorder=3))
+        ax.plot([], [], color="tab:green", linewidth=0.6, label=f"{len(kept)} loop closures")
+        title += f", {len(graph)} keyframes"
+    for label, (x, y) in (("S", result.poses[0, :2]), ("E", result.poses[-1, :2])):
+        ax.annotate(label, (x, y), xytext=(6, 4), textcoords="offset points", fontsize=12)
+    # the view: the run, its map and the truth, not the odometry's drift
+    seen = [result.poses[:, :2], *([line.sp, line.ep] for line in result.map)]
+    if log.truth is not None:
+        seen.append(log.truth[:, :2])
+    if log.world is not None:
+        seen.append(np.reshape(log.world.walls, (-1, 2)))
+    lo, hi = np.min(np.vstack(seen), axis=0), np.max(np.vstack(seen), axis=0)
+    pad = 0.05 * (hi - lo).max() + 0.5
+    ax.set_aspect("equal", adjustable="box")
+    ax.set_xlim(lo[0] - pad, hi[0] + pad)
+    ax.set_ylim(lo[1] - pad, hi[1] + pad)
+    ax.set_title(title)
+    ax.set_xlabel("x (m)")
+    ax.set_ylabel("y (m)")
+    ax.legend(loc="best", fontsize=9)
     return fig

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 import pytest
 
@@ -260,6 +262,16 @@ CLINIC = (
 )
 
 
+@functools.cache
+def _plain_run(name):
+    """The default SLAM on a shared log as it is: its timestamps and poses (run once per
+    session)."""
+    from fhslam.datasets import load_log
+
+    r = run_slam(load_log(name))
+    return r.timestamps, r.poses
+
+
 def _relations_error(real_data, name, odometry_noise_seed=None, drop_fraction=0.0):
     from dataclasses import replace
 
@@ -267,6 +279,9 @@ def _relations_error(real_data, name, odometry_noise_seed=None, drop_fraction=0.
     from fhslam.io import read_relations
     from fhslam.metrics import relations_error
 
+    rel = read_relations(find_dataset(name, "relations"))
+    if odometry_noise_seed is None and not drop_fraction:
+        return relations_error(*_plain_run(name), *rel)
     log = load_log(name)  # found where the real_data fixture found them
     if odometry_noise_seed is not None:  # last-bit noise: what another CPU may do
         rng = np.random.default_rng(odometry_noise_seed)
@@ -277,7 +292,6 @@ def _relations_error(real_data, name, odometry_noise_seed=None, drop_fraction=0.
 
         log = degrade(log, drop_fraction=drop_fraction, seed=0)
     r = run_slam(log)  # the default method, the same defaults for every log
-    rel = read_relations(find_dataset(name, "relations"))
     return relations_error(r.timestamps, r.poses, *rel)
 
 
@@ -308,6 +322,22 @@ def test_real_log_relations_error_meets_issue_10(real_data, name):
     e = _relations_error(real_data, name)
     assert e.n_used == e.n_total
     assert e.trans_mean <= limit, f"{name}: {e.trans_mean:.4f} m (measured {measured} m)"
+
+
+def test_the_hospitals_relations_under_a_minute_hold(real_data):
+    """The hospital's mean over all relations is decided by its unclosed return (the xfail
+    above); its 2,642 relations under a minute measure the local accuracy: 0.0938 m (0.0965 m
+    at stop 24; 0.094-0.100 m with 1 mm range noise or 10 % of the scans dropped; the
+    odometry's 0.0772 m is still better)."""
+    from fhslam.datasets import find_dataset
+    from fhslam.io import read_relations
+    from fhslam.metrics import relations_error
+
+    t1, t2, z = read_relations(find_dataset("fr-clinic", "relations"))
+    short = np.abs(t2 - t1) < 60
+    e = relations_error(*_plain_run("fr-clinic"), t1[short], t2[short], z[short])
+    assert e.n_used == short.sum() == 2642
+    assert e.trans_mean <= 0.105, f"{e.trans_mean:.4f} m"
 
 
 @pytest.mark.parametrize("seed", [1, 2])

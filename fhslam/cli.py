@@ -159,6 +159,8 @@ def _evaluate(args: argparse.Namespace) -> None:
             raise InputError(f"{', '.join(given)}: only with --truth, not with --relations")
         max_diff = 0.001 if args.max_diff is None else args.max_diff
         rep = evaluate_relations(args.trajectory, args.relations, max_diff)
+        if args.plot is not None:
+            _plot_errors(args, rep.relations, max_diff)
         if args.json:
             print(json.dumps(rep.as_dict(), allow_nan=False))
             return
@@ -176,6 +178,8 @@ def _evaluate(args: argparse.Namespace) -> None:
             f"squared {e.rot_sq_mean_deg:.3f} ± {e.rot_sq_std_deg:.3f} deg²"
         )
         print(f"{e.n_used} of {e.n_total} relations used")
+        if args.plot is not None:
+            print(f"wrote a picture of the errors to {args.plot}")
         return
 
     if (args.world is None) != (args.map is None):
@@ -194,6 +198,8 @@ def _evaluate(args: argparse.Namespace) -> None:
         delta=delta,
         align=args.align,
     )
+    if args.plot is not None:
+        _plot_errors(args, args.truth, max_diff)
     if args.json:
         print(json.dumps(rep.as_dict(), allow_nan=False))
         return
@@ -215,6 +221,38 @@ def _evaluate(args: argparse.Namespace) -> None:
             + ("n/a" if cov is None else f"{100 * cov:.1f} %")
             + f" of {rep.map['n_observed_points']} observed wall points"
         )
+    if args.plot is not None:
+        print(f"wrote a picture of the errors to {args.plot}")
+
+
+def _plot_errors(args: argparse.Namespace, reference: Path, max_diff: float) -> None:
+    """Draw ``fhslam evaluate``'s errors into the PNG ``args.plot``: against the relations
+    file or the truth file ``reference`` (already read once, so known to be good)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from fhslam.figures import pose_errors_figure, relation_errors_figure
+    from fhslam.io import read_relations, read_trajectory
+    from fhslam.io.files import atomic_output, check_outputs
+
+    inputs = {"the trajectory": args.trajectory, "the reference": reference}
+    check_outputs({"--plot": args.plot}, inputs)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # evaluated above: its warnings were shown then
+        t, poses = read_trajectory(args.trajectory)
+        title = Path(args.trajectory).name
+        if args.relations is not None:
+            fig = relation_errors_figure(t, poses, *read_relations(reference), max_diff, title)
+        else:
+            t_ref, ref = read_trajectory(reference)
+            fig = pose_errors_figure(t, poses, t_ref, ref, max_diff, args.align, title)
+    try:
+        with atomic_output(args.plot, "wb") as f:
+            fig.savefig(f, format="png", dpi=100, bbox_inches="tight", metadata={"Software": None})
+    finally:
+        plt.close(fig)
 
 
 def _check_delta(trajectory: Path, truth: Path, max_diff: float, delta: int) -> None:
@@ -573,6 +611,12 @@ def build_parser() -> argparse.ArgumentParser:
         "--align", action="store_true", help="SE(2)-align the estimate before ATE (--truth only)"
     )
     p.add_argument("--json", action="store_true", help="print one JSON object")
+    p.add_argument(
+        "--plot",
+        type=Path,
+        help="output PNG: each relation's error over the run, coloured by the time between "
+        "its poses (--relations); the trajectory and each pose's error over time (--truth)",
+    )
     p.set_defaults(run=_evaluate)
 
     p = sub.add_parser("reproduce", help="write the paper's figures as PNG files")

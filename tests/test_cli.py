@@ -507,6 +507,77 @@ def test_slam_on_a_dataset_name_then_relations(tmp_path, real_data, monkeypatch)
     assert r.stderr.count("\n") == 1
 
 
+def _relations_case(folder):
+    """A trajectory 1 % too long on a straight line and true relations 5 and 40 poses apart."""
+    from fhslam.geometry import relative
+    from fhslam.io import write_trajectory
+
+    t = 100.0 + np.arange(60)
+    truth = np.column_stack([0.1 * np.arange(60), np.zeros(60), np.zeros(60)])
+    est = truth * [1.01, 1, 1]
+    write_trajectory(folder / "est.txt", t, est)
+    pairs = [(k, k + 5) for k in range(0, 55, 5)] + [(0, 40), (10, 50)]
+    lines = [
+        f"{t[a]} {t[b]} {r[0]} {r[1]} 0 0 0 {r[2]}"
+        for a, b in pairs
+        for r in [relative(truth[a], truth[b])]
+    ]
+    (folder / "case.relations").write_text("\n".join(lines) + "\n")
+    return folder / "est.txt", folder / "case.relations"
+
+
+def test_evaluate_plot_draws_the_errors(tmp_path, capsys):
+    """``evaluate --plot PNG``: with ``--relations`` each relation's error over the run, with
+    ``--truth`` the trajectory and each pose's error; the report (text or ``--json``) is as
+    without it. What the figures show: ``tests/test_figures.py``."""
+    import matplotlib.image
+
+    from fhslam.io import write_trajectory
+
+    traj, relations = _relations_case(tmp_path)
+    assert main(["evaluate", str(traj), "--relations", str(relations), "--json"]) == 0
+    plain = capsys.readouterr().out
+    png = tmp_path / "rel.png"
+    argv = ["evaluate", str(traj), "--relations", str(relations), "--plot", str(png)]
+    assert main([*argv, "--json"]) == 0
+    assert capsys.readouterr().out == plain  # one JSON object, nothing else
+    assert main(argv) == 0
+    out = capsys.readouterr().out
+    assert "13 of 13 relations used" in out and out.endswith(
+        f"wrote a picture of the errors to {png}\n"
+    )
+    t, est = read_trajectory(traj)
+    write_trajectory(tmp_path / "truth.txt", t, est * [1 / 1.01, 1, 1])
+    png2 = tmp_path / "ate.png"
+    assert (
+        main(["evaluate", str(traj), "--truth", str(tmp_path / "truth.txt"), "--plot", str(png2)])
+        == 0
+    )
+    assert capsys.readouterr().out.endswith(f"wrote a picture of the errors to {png2}\n")
+    for p in (png, png2):
+        image = matplotlib.image.imread(p)
+        assert image.ndim == 3 and image.shape[1] > 600 and image[..., :3].std() > 0.05
+
+
+def test_evaluate_plot_over_an_input_writes_nothing(tmp_path):
+    traj, relations = _relations_case(tmp_path)
+    before = sorted(tmp_path.iterdir())
+    r = run("evaluate", str(traj), "--relations", str(relations), "--plot", str(relations))
+    assert r.returncode == 2 and r.stdout == "" and r.stderr.count("\n") == 1
+    assert f"--plot {relations}: is the reference" in r.stderr
+    assert sorted(tmp_path.iterdir()) == before
+    r = run(
+        "evaluate",
+        str(traj),
+        "--relations",
+        str(relations),
+        "--plot",
+        str(tmp_path / "no" / "x.png"),
+    )
+    assert r.returncode == 2 and r.stdout == "" and r.stderr.count("\n") == 1
+    assert sorted(tmp_path.iterdir()) == before
+
+
 def test_info_reads_a_bag_and_reports_the_max_range(tmp_path, capsys):
     """``fhslam info`` reads whatever ``fhslam slam`` reads, here a ROS bag."""
     from test_rosbag import write_bag

@@ -185,3 +185,52 @@ def test_a_slam_run_figure_shows_the_run_its_closures_and_not_the_odometrys_drif
     assert inside(result.poses).all() and inside(np.reshape(log.world.walls, (-1, 2))).all()
     assert x1 - x0 < 25 and not inside(drifted).all()  # the world's 14 m, not the drift's 40
     plt.close(fig)
+
+
+def test_the_error_figures_draw_each_error_where_it_happened():
+    """:func:`fhslam.figures.relation_errors_figure` and :func:`pose_errors_figure`
+    (``fhslam evaluate --plot``): each relation's errors at the time of its first pose,
+    coloured by the time between its poses, a dashed line at the mean; each pose's error at
+    its time, a dashed line at the rmse; no usable relation or pose is refused."""
+    from fhslam import metrics
+    from fhslam.geometry import relative
+
+    t = 100.0 + np.arange(60)
+    truth = np.column_stack([0.1 * np.arange(60), np.zeros(60), 0.01 * np.arange(60)])
+    est = truth.copy()
+    est[30:, 1] += 0.2  # a 20 cm jump half-way
+    pairs = [(k, k + 5) for k in range(0, 55, 5)] + [(0, 40)]
+    t1, t2 = t[[a for a, _ in pairs]], t[[b for _, b in pairs]]
+    rel = np.array([relative(truth[a], truth[b]) for a, b in pairs])
+    trans, rot, _ = metrics.relations_errors(t, est, t1, t2, rel)
+    fig = figures.relation_errors_figure(t, est, t1, t2, rel, title="case")
+    a, b = fig.axes[:2]
+    for ax, err in ((a, trans), (b, np.degrees(rot))):
+        (points,) = ax.collections
+        np.testing.assert_allclose(points.get_offsets(), np.column_stack([t1 - 100, err]))
+        np.testing.assert_allclose(points.get_array(), np.maximum(t2 - t1, 5))  # gaps 5 and 40 s
+        (mean,) = ax.get_lines()
+        assert mean.get_ydata()[0] == pytest.approx(np.mean(err))
+    assert trans.max() == pytest.approx(0.2) and (trans > 0.1).sum() == 2  # 25-30 and 0-40
+    assert a.get_title() == (
+        f"case: 12 of 12 relations, translational {trans.mean():.4f} m, rotational "
+        f"{np.degrees(rot).mean():.3f}° (means)"
+    )
+    plt.close(fig)
+
+    fig = figures.pose_errors_figure(t, est, t, truth, title="case")
+    left, right = fig.axes[:2]
+    err = np.where(np.arange(60) >= 30, 0.2, 0.0)
+    (points,) = right.collections
+    np.testing.assert_allclose(points.get_offsets(), np.column_stack([t - 100, err]), atol=1e-12)
+    rmse = np.sqrt(np.mean(err**2))
+    assert right.get_lines()[0].get_ydata()[0] == pytest.approx(rmse)
+    assert right.get_yscale() == "linear"  # errors of 0: no log scale
+    assert fig._suptitle.get_text() == f"case: ATE rmse {rmse:.4f} m over 60 poses"
+    assert len(left.get_lines()) == 2  # truth and estimate
+    plt.close(fig)
+
+    with pytest.raises(ValueError, match="none of the 12 relations"):
+        figures.relation_errors_figure(t + 1000, est, t1, t2, rel)
+    with pytest.raises(ValueError, match="no pose of the estimate"):
+        figures.pose_errors_figure(t + 1000, est, t, truth)

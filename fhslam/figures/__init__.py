@@ -15,6 +15,7 @@ writes them all (:func:`reproduce`). Everything is
 re-exported here, so ``from fhslam.figures import ...`` works for both.
 """
 
+from fhslam.figures.errors import pose_errors_figure, relation_errors_figure
 from fhslam.figures.loop1 import (
     fig01_hough_principle,
     fig02_environment,
@@ -67,6 +68,8 @@ __all__ = [
     "line_attributes_example",
     "merging_example",
     "paper_log",
+    "pose_errors_figure",
+    "relation_errors_figure",
     "reproduce",
     "similarity_examples",
     "slam_log",

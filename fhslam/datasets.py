@@ -66,7 +66,9 @@ KINDS: tuple[str, ...] = ("log", "relations")
 
 
 class DatasetNotFoundError(MissingInputError):
-    """No copy of a dataset file was found (and no download was asked for)."""
+    """No copy of a dataset file was found, and none was downloaded: no download was asked
+    for, or it failed (no network, a server error, a file whose sha256 is not the recorded
+    one)."""
 
 
 @dataclass(frozen=True)
@@ -278,7 +280,9 @@ def find_dataset(
     is downloaded unless ``download=True``.
 
     Raises :class:`DatasetNotFoundError` (a :class:`~fhslam.errors.MissingInputError`) listing
-    every place looked at, :class:`~fhslam.errors.InputError` for an unknown name, for a
+    every place looked at, or naming the URL and the cause when a download fails (a network
+    error, or a downloaded file whose sha256 is not the recorded one);
+    :class:`~fhslam.errors.InputError` for an unknown name, for a
     dataset without a file of ``kind`` (mit-killian has no log) and for a local copy whose
     size is not the recorded one, ``ValueError`` for an unknown kind.
     """
@@ -311,9 +315,18 @@ def find_dataset(
     if download:
         import pooch
 
-        got = pooch.retrieve(
-            f.url, known_hash=f.known_hash, fname=f.name, path=pooch.os_cache("fhslam")
-        )
+        try:
+            got = pooch.retrieve(
+                f.url, known_hash=f.known_hash, fname=f.name, path=pooch.os_cache("fhslam")
+            )
+        except (OSError, ValueError) as e:
+            # requests' errors are OSErrors; pooch raises a ValueError for a hash mismatch
+            cause = " ".join(str(e).split()) or type(e).__name__
+            raise DatasetNotFoundError(
+                f"could not download {f.name} for dataset {ds.name!r} from {f.url}: {cause}; "
+                f"put a copy in ${ENV_VAR} or ../shared/data",
+                f.name,
+            ) from e
         return Path(got)
 
     places = "\n".join(f"  - {s}" for s in looked)

@@ -51,7 +51,7 @@ def as_points(points: ArrayLike, name: str = "points") -> NDArray[np.float64]:
         i = int(np.flatnonzero(bad)[0])
         raise ValueError(
             f"{name} contains {int(bad.sum())} non-finite rows (first at index {i}: "
-            f"{p[i].tolist()}); drop invalid beams first (fhslam.extraction.scan_to_points)"
+            f"{p[i].tolist()}); drop invalid beams first (fhslam.scan.scan_to_points)"
         )
     return p
 

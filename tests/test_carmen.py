@@ -793,3 +793,78 @@ def test_no_return_reading_with_a_stated_range_keeps_the_five_logs_codes():
     for stated in (None, 80.0, 81.9, 100.0, 160.0):
         assert no_return_reading(r, stated=stated) == 81.83
     assert no_return_reading(r, stated=170.0) is None  # 81.83 m is far below 170 m
+
+
+# ------------------------------------------------------------------ headings counting turns
+
+
+def _count_turns(text: str, turns: float) -> str:
+    """A CARMEN log ``text`` with ``turns`` full turns added to every heading: the laser
+    pose's and the odometry's of each ``FLASER`` line, and each ``ODOM`` line's."""
+    out = []
+    for line in text.splitlines():
+        f = line.split()
+        if f and f[0] == "FLASER":
+            n = int(f[1])
+            for i in (4 + n, 7 + n):  # laser theta, odom theta
+                f[i] = repr(float(f[i]) + turns * 2 * np.pi)
+        elif f and f[0] == "ODOM":
+            f[3] = repr(float(f[3]) + turns * 2 * np.pi)
+        out.append(" ".join(f) if f else line)
+    return "\n".join(out) + "\n"
+
+
+@pytest.mark.parametrize("turns", [1, -1, 3])
+def test_log_headings_counting_turns_are_wrapped_on_reading(tmp_path, turns):
+    """A log whose headings count the turns (theta + 2 pi k) reads as the same log: every
+    odometry heading in (-pi, pi] (the convention of DESIGN.md), equal to the plain log's."""
+    log = simulate(paper_world(), seed=0)  # the whole drive: headings all round the circle
+    plain_path = tmp_path / "plain.clf"
+    write_carmen(log, plain_path)
+    turned_path = tmp_path / "turned.clf"
+    turned_path.write_text(_count_turns(plain_path.read_text(), turns))
+    plain, turned = read_carmen(plain_path), read_carmen(turned_path)
+    theta = turned.odometry[:, 2]
+    assert np.all((theta > -np.pi) & (theta <= np.pi)), (theta.min(), theta.max())
+    assert np.abs(plain.odometry[:, 2]).max() > 3.1  # the test covers headings near ±pi
+    np.testing.assert_allclose(turned.odometry, plain.odometry, rtol=0, atol=1e-12)
+    assert np.array_equal(plain.odometry, log.odometry)  # the plain log: bit for bit as before
+    np.testing.assert_allclose(turned.laser_offset, plain.laser_offset, rtol=0, atol=1e-12)
+
+
+def test_log_wraps_headings_and_keeps_wrapped_ones_bit_for_bit():
+    """Log wraps the headings of odometry, truth and the laser's mount to (-pi, pi]; a
+    heading already in it is kept exactly, and the caller's arrays are left alone."""
+    thetas = np.array([0.1, np.pi, -np.pi, 7.0, -7.0, 3 * np.pi, -np.nextafter(np.pi, 0)])
+    want = np.array(
+        [0.1, np.pi, np.pi, 7.0 - 2 * np.pi, 2 * np.pi - 7.0, np.pi, -np.nextafter(np.pi, 0)]
+    )
+    t = len(thetas)
+    odometry = np.column_stack([np.arange(t, dtype=float), np.zeros(t), thetas])
+    truth = odometry[::-1].copy()
+    given = odometry.copy(), truth.copy()
+    offset = np.array([0.2, 0.0, 4.0])
+    log = Log(
+        name="turns",
+        timestamps=np.arange(t, dtype=float),
+        ranges=np.ones((t, 3)),
+        angles=np.array([-0.1, 0.0, 0.1]),
+        odometry=odometry,
+        max_range=8.0,
+        truth=truth,
+        laser_offset=offset,
+    )
+    np.testing.assert_allclose(log.odometry[:, 2], want, rtol=0, atol=1e-12)
+    np.testing.assert_allclose(log.truth[:, 2], want[::-1], rtol=0, atol=1e-12)
+    for got in (log.odometry, log.truth):
+        assert np.all((got[:, 2] > -np.pi) & (got[:, 2] <= np.pi))
+    keep = [0, 1, 6]  # in (-pi, pi] already: the very same floats
+    assert log.odometry[keep, 2].tolist() == thetas[keep].tolist()
+    assert np.array_equal(log.odometry[:, :2], odometry[:, :2])
+    assert log.laser_offset[2] == pytest.approx(4.0 - 2 * np.pi, abs=1e-12)
+    assert log.laser_offset[:2].tolist() == [0.2, 0.0]
+    assert np.array_equal(odometry, given[0]) and np.array_equal(truth, given[1])
+    assert offset.tolist() == [0.2, 0.0, 4.0]
+    again = replace(log)  # idempotent: a wrapped log is rebuilt bit for bit
+    assert np.array_equal(again.odometry, log.odometry)
+    assert np.array_equal(again.truth, log.truth)

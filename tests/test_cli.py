@@ -57,6 +57,47 @@ def test_simulate_accepts_a_world_file(tmp_path):
     assert len(read_carmen(out)) > 10
 
 
+def test_slam_odometry_of_a_log_counting_turns_stays_in_minus_pi_pi(tmp_path):
+    """A CARMEN log whose headings are theta + 2 pi (a logger counting the turns): the
+    trajectories written are in (-pi, pi], the same as the plain log's."""
+    from test_carmen import _count_turns
+
+    plain = tmp_path / "p.clf"
+    assert main(["simulate", "paper", "--seed", "0", "--log", str(plain), "--truth",
+                 str(tmp_path / "truth.txt"), "--quiet"]) == 0  # fmt: skip
+    turned = tmp_path / "rot.clf"
+    turned.write_text(_count_turns(plain.read_text(), 1))
+    for log, out in ((plain, "o0.txt"), (turned, "o.txt")):
+        args = ["slam", str(log), "--method", "odometry", "--trajectory", str(tmp_path / out)]
+        assert main([*args, "--quiet"]) == 0
+    _, poses = read_trajectory(tmp_path / "o.txt")
+    _, want = read_trajectory(tmp_path / "o0.txt")
+    assert np.all((poses[:, 2] > -np.pi) & (poses[:, 2] <= np.pi))
+    assert poses[0, 2] == 0.0
+    np.testing.assert_allclose(poses, want, rtol=0, atol=1e-12)
+
+
+def test_simulate_wraps_the_start_heading_of_a_world_file(tmp_path):
+    world = tmp_path / "box.json"
+    world.write_text(
+        json.dumps(
+            {
+                "name": "box",
+                "walls": [[0, 0, 6, 0], [6, 0, 6, 4], [6, 4, 0, 4], [0, 4, 0, 0]],
+                "route": [[1, 1], [5, 1], [5, 3]],
+                "start": [1, 1, 7.0],
+            }
+        )
+    )
+    log, truth = tmp_path / "box.clf", tmp_path / "t.txt"
+    assert main(["simulate", str(world), "--log", str(log), "--truth", str(truth), "--quiet"]) == 0
+    _, poses = read_trajectory(truth)
+    assert poses[0, 2] == pytest.approx(7.0 - 2 * np.pi, abs=1e-12)
+    assert np.all((poses[:, 2] > -np.pi) & (poses[:, 2] <= np.pi))
+    odometry = read_carmen(log).odometry[:, 2]
+    assert np.all((odometry > -np.pi) & (odometry <= np.pi))
+
+
 def test_info_summarises_a_log(tmp_path, capsys):
     out = tmp_path / "paper.clf"
     main(["simulate", "paper", "--log", str(out), "--truth", str(tmp_path / "t.txt")])

@@ -8,6 +8,7 @@ from pathlib import Path
 
 import pooch
 import pytest
+import requests
 
 from fhslam import datasets as data
 from fhslam.datasets import (
@@ -239,6 +240,70 @@ def test_download_of_a_real_entry_uses_its_github_url(fake, monkeypatch):
         "inesctec_mrdt_slam_2d_datasets/data/aces.relations",
         "known_hash": "sha256:11a15800a751b6f9413078a021d49c7cda85a768c2a465433b4fae7ef57b03d5",
     }
+
+
+DOWNLOAD_FAILURES = [
+    requests.exceptions.ConnectionError(
+        "HTTPSConnectionPool(host='raw.githubusercontent.com', port=443): Max retries "
+        "exceeded\n(Caused by NameResolutionError)"
+    ),
+    OSError(28, "No space left on device"),
+    ValueError(
+        "SHA256 hash of downloaded file (intel.orig.bag) does not match the known hash: "
+        "expected sha256:b37c but got 0000. Deleted download for safety."
+    ),
+]
+
+
+def _failing_retrieve(monkeypatch, error: Exception) -> list:
+    """Make pooch.retrieve raise ``error``; the list returned records each call's URL."""
+    calls = []
+
+    def retrieve(url, *args, **kwargs):
+        calls.append(url)
+        raise error
+
+    monkeypatch.setattr(pooch, "retrieve", retrieve)
+    return calls
+
+
+@pytest.mark.parametrize("error", DOWNLOAD_FAILURES, ids=["connection", "oserror", "sha256"])
+def test_failed_download_names_the_dataset_file_url_and_cause(fake, monkeypatch, error):
+    calls = _failing_retrieve(monkeypatch, error)
+    f = DATASETS["fake"].log
+    with pytest.raises(DatasetNotFoundError) as e:
+        find_dataset("fake", download=True)
+    assert calls == [f.url]
+    assert isinstance(e.value, InputError) and e.value.__cause__ is error
+    msg = str(e.value)
+    assert msg.startswith(f"could not download fake.clf for dataset 'fake' from {f.url}: ")
+    assert " ".join(str(error).split()) in msg and "\n" not in msg
+    assert "$FHSLAM_DATA" in msg
+
+
+@pytest.mark.parametrize("error", DOWNLOAD_FAILURES, ids=["connection", "oserror", "sha256"])
+def test_failed_download_is_a_one_line_cli_error(tmp_path, monkeypatch, capsys, error):
+    """`fhslam slam intel --download` with the download failing: exit status 2 and one line
+    naming the dataset, the file and the URL; no traceback, no output. No local copy is
+    found even where the shared data folder exists, and the network is never touched."""
+    from fhslam.cli import main
+
+    empty = tmp_path / "empty"
+    empty.mkdir()
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.setenv(data.ENV_VAR, str(empty))
+    monkeypatch.setattr(data, "search_dirs", lambda: [(f"${data.ENV_VAR}", empty)])
+    calls = _failing_retrieve(monkeypatch, error)
+    out = tmp_path / "t.txt"
+    assert main(["slam", "intel", "--download", "--trajectory", str(out), "--quiet"]) == 2
+    f = DATASETS["intel"].log
+    assert calls == [f.url]  # the download was tried, and failed
+    captured = capsys.readouterr()
+    assert captured.out == ""
+    assert captured.err.startswith("fhslam: error: could not download intel.orig.bag for ")
+    assert captured.err.count("\n") == 1 and "Traceback" not in captured.err
+    assert "dataset 'intel'" in captured.err and f.url in captured.err
+    assert not out.exists() and sorted(p.name for p in tmp_path.iterdir()) == ["empty"]
 
 
 def test_verify_checks_sha256(fake, monkeypatch):

@@ -285,6 +285,29 @@ def test_load_world_builtins_and_files(tmp_path):
     assert load_world(str(path)).name == "room"
 
 
+def test_a_world_start_heading_is_wrapped(tmp_path):
+    """A start heading outside (-pi, pi] is wrapped (7.0 is 7.0 - 2 pi), in the world, its
+    JSON and the simulated truth; one inside it is kept exactly; the caller's array too."""
+    room = {"name": "room", "walls": SQUARE.tolist(), "route": [[0, 0], [1, 0]]}
+    path = tmp_path / "room.json"
+    path.write_text(json.dumps({**room, "start": [0, 0, 7.0]}))
+    w = load_world(path)
+    assert w.start[:2].tolist() == [0.0, 0.0]
+    assert w.start[2] == pytest.approx(7.0 - 2 * np.pi, abs=1e-12)
+    assert World.from_dict(w.to_dict()).start.tolist() == w.start.tolist()
+    log = simulate(w, seed=0, max_scans=5)
+    assert log.truth[0].tolist() == w.start.tolist()
+    for poses in (log.truth, log.odometry):
+        assert np.all((poses[:, 2] > -np.pi) & (poses[:, 2] <= np.pi))
+    for given, want in ((-np.pi, np.pi), (-7.0, 2 * np.pi - 7.0), (3 * np.pi, np.pi)):
+        start = np.array([0.0, 0.0, given])
+        got = World.from_dict({**room, "start": start}).start[2]
+        assert got == pytest.approx(want, abs=1e-12) and -np.pi < got <= np.pi
+        assert start[2] == given and start.flags.writeable  # not the caller's array
+    for kept in (0.5, np.pi, -np.nextafter(np.pi, 0)):
+        assert World.from_dict({**room, "start": [0, 0, kept]}).start[2] == kept
+
+
 def test_load_world_unknown_name_lists_builtins():
     with pytest.raises(ValueError, match=r"unknown world 'office'.*paper.*random:SEED"):
         load_world("office")

@@ -560,8 +560,10 @@ def read_carmen(path: str | PathLike[str], max_range: float | None = None) -> Lo
     Log
         ``name`` is the file's stem; ``timestamps`` the ``ipc_timestamp`` of each scan;
         ``odometry`` the ``odom_x odom_y odom_theta`` triple of ``FLASER`` (the
-        ``robot_pose`` of ``ROBOTLASER1``); ``angles`` :func:`flaser_angles` for ``FLASER``
-        (with the log's resolution and field-of-view ``PARAM`` lines, if any),
+        ``robot_pose`` of ``ROBOTLASER1``), its heading wrapped to (-pi, pi] (by
+        :class:`~fhslam.io.log.Log`; a heading already in it is kept as written);
+        ``angles`` :func:`flaser_angles` for ``FLASER`` (with the log's resolution and
+        field-of-view ``PARAM`` lines, if any),
         ``start_angle + k * angular_resolution`` for ``ROBOTLASER1``; ``laser_offset`` the
         laser's mount and ``laser_offset_source`` where it came from, ``"PARAM"``,
         ``"laser pose"`` or ``"none"`` (the rule is in the module docstring);

@@ -17,6 +17,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from fhslam.errors import InputError, InputWarning
+from fhslam.geometry import wrap_angle
 from fhslam.io.files import input_path, reading
 from fhslam.scan import Scan
 
@@ -39,10 +40,13 @@ class Log:
         ahead (the same for every scan).
     odometry : ndarray, shape (T, 3)
         Odometry pose ``(x, y, theta)`` of the robot at each scan, in the odometry frame.
+        ``theta`` is wrapped to (-pi, pi] on construction, whatever the source states (a
+        CARMEN log may count the turns: 2 pi + 0.1); one already in it is kept as given.
     max_range : float
         Largest range the laser reports, metres; readings ``>= max_range`` mean "no return".
     truth : ndarray, shape (T, 3), or None
-        Ground-truth pose at each scan (simulated logs only).
+        Ground-truth pose at each scan (simulated logs only); ``theta`` wrapped as for
+        ``odometry``.
     hits : ndarray of int, shape (T, B), or None
         Index of the wall of ``world`` hit by each beam, -1 for no return (simulated only).
     world : fhslam.sim.World or None
@@ -51,7 +55,7 @@ class Log:
     laser_offset : ndarray, shape (3,)
         Pose of the laser on the robot, ``robot_T_laser`` (zero: the laser at the robot's
         origin). SLAM estimates laser poses ``odometry ⊕ laser_offset`` and reports robot
-        poses.
+        poses. Its angle is wrapped as ``odometry``'s.
     angle_offsets : ndarray, shape (T,), or None
         Per-scan offset added to ``angles``, radians (an interlaced laser whose successive
         scans start a quarter of a beam apart, as in the Freiburg hospital log); ``None``:
@@ -87,6 +91,7 @@ class Log:
         )
         if self.laser_offset.shape != (3,) or not np.all(np.isfinite(self.laser_offset)):
             raise ValueError(f"Log.laser_offset must be 3 finite numbers, got {self.laser_offset}")
+        self.laser_offset = _wrap_headings(self.laser_offset)
         self.timestamps = np.asarray(self.timestamps, dtype=float)
         self.ranges = np.asarray(self.ranges, dtype=float)
         self.angles = np.asarray(self.angles, dtype=float)
@@ -104,12 +109,14 @@ class Log:
             )
         if self.odometry.shape != (t, 3):
             raise ValueError(f"Log.odometry must have shape ({t}, 3), got {self.odometry.shape}")
+        self.odometry = _wrap_headings(self.odometry)
         if not self.max_range > 0:
             raise ValueError(f"Log.max_range must be positive, got {self.max_range}")
         if self.truth is not None:
             self.truth = np.asarray(self.truth, dtype=float)
             if self.truth.shape != (t, 3):
                 raise ValueError(f"Log.truth must have shape ({t}, 3), got {self.truth.shape}")
+            self.truth = _wrap_headings(self.truth)
         if self.angle_offsets is not None:
             self.angle_offsets = np.asarray(self.angle_offsets, dtype=float)
             if self.angle_offsets.shape != (t,) or not np.all(np.isfinite(self.angle_offsets)):
@@ -144,6 +151,23 @@ class Log:
             f"Log({self.name!r}: {len(self)} scans x {self.n_beams} beams, {duration:.1f} s, "
             f"max_range={self.max_range:g} m{', with ' + ' and '.join(extras) if extras else ''})"
         )
+
+
+def _wrap_headings(poses: NDArray[np.float64]) -> NDArray[np.float64]:
+    """``poses`` (shape (..., 3)) with every angle ``theta`` wrapped to (-pi, pi].
+
+    Only the angles outside the interval change (:func:`~fhslam.geometry.wrap_angle`); one
+    inside it is kept bit for bit, and ``poses`` itself is never written to (a changed copy
+    is returned). Non-finite angles are left alone.
+    """
+    theta = poses[..., 2]
+    bad = np.isfinite(theta) & ((theta <= -np.pi) | (theta > np.pi))
+    if not bad.any():
+        return poses
+    poses = poses.copy()
+    theta = poses[..., 2]  # a view of the copy
+    theta[bad] = wrap_angle(theta[bad])
+    return poses
 
 
 NO_RETURN_MIN_SHARE = 1e-3

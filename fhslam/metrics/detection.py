@@ -99,7 +99,7 @@ def match_scan(
     lines : sequence of Line
         Extracted lines, in the laser frame, with ``inliers`` indexing the scan's points.
     beams : array-like of int, shape (N,)
-        Beam index of every point (from :func:`fhslam.extraction.scan_to_points`).
+        Beam index of every point (from :func:`fhslam.scan.scan_to_points`).
     truth, run_of_beam
         From :func:`fhslam.sim.true_lines`.
 

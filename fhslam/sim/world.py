@@ -6,9 +6,10 @@ A world is stored as JSON (see DESIGN.md)::
      "start": [x, y, theta]}
 
 in metres and radians; ``start`` is optional (default: the first waypoint, heading to the
-second). Every coordinate must be a JSON number (``true``, ``"1"`` or ``null`` are refused, not
-read as 1, 1 or NaN); a key other than these four is read as a misspelling: the world is used
-without it and an :class:`~fhslam.errors.InputWarning` names the key and the known ones
+second; a heading given is wrapped to (-pi, pi]). Every coordinate must be a JSON number
+(``true``, ``"1"`` or ``null`` are refused, not read as 1, 1 or NaN); a key other than these
+four is read as a misspelling: the world is used without it and an
+:class:`~fhslam.errors.InputWarning` names the key and the known ones
 (:meth:`World.from_dict`).
 
 Built-in worlds: ``"paper"`` (:func:`paper_world`, the paper's 18.7 x 14.0 m office),
@@ -31,7 +32,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from fhslam.errors import InputError, InputWarning
-from fhslam.geometry import compose, segment_distances, transform_points
+from fhslam.geometry import compose, segment_distances, transform_points, wrap_angle
 from fhslam.io.files import input_path, reading
 from fhslam.io.mapfile import MAX_COORDINATE
 
@@ -126,6 +127,7 @@ class World:
         Waypoints the robot drives through in order, metres.
     start : ndarray, shape (3,)
         Initial pose ``(x, y, theta)``; by default the first waypoint, facing the second.
+        ``theta`` is wrapped to (-pi, pi] (a heading already in it is kept as given).
 
     Raises
     ------
@@ -177,6 +179,9 @@ class World:
                     f"field 'start' lies beyond the plausible {MAX_COORDINATE:g} m: "
                     f"{start.tolist()}"
                 )
+        if not -np.pi < start[2] <= np.pi:  # 7.0 is 7.0 - 2 pi; only such a heading changes
+            start = start.copy()  # never the caller's array
+            start[2] = wrap_angle(start[2])
         # The robot drives from the start to the first waypoint, then along the route: a
         # leg through a wall would put it on the far side of it without a word.
         legs = np.vstack([start[:2], route])

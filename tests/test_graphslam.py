@@ -66,6 +66,38 @@ def test_a_closure_that_moves_its_keyframe_far_waits_for_an_independent_one():
         assert not slam._agree(g, (1, 11, None, None, 0.6, compose(same, off)), poses)
 
 
+
+def test_closures_confirm_each_other_only_when_they_share_no_keyframe():
+    """Independent: the queries (keyframes i-2..i) apart, and the targets (candidate j and
+    three on either side) too."""
+    slam = GraphFastHoughSLAM()  # loop_min_gap 20
+    assert slam._target(50, 100) == range(47, 54)
+    assert slam._target(2, 100) == range(0, 6) and slam._target(79, 100) == range(76, 81)
+    assert slam._independent((50, 97), (57, 100))
+    assert not slam._independent((50, 98), (57, 100))  # keyframe 98 in both queries
+    assert not slam._independent((51, 97), (57, 100))  # keyframe 54 in both targets
+    assert not slam._independent((0, 97), (0, 100)) and not slam._independent((1, 97), (0, 100))
+
+
+def test_a_corridor_ring_comes_back_to_its_start_without_a_false_closure():
+    """The ``ring`` (150 m of corridor a lap, 8 m laser): back at its start the robot faces
+    south where the first keyframes faced east. Two queries three keyframes apart matched the
+    same start keyframes a corridor's width off (scores 0.55-0.72, 3.5 m off), agreed, and
+    bent the whole run (ATE 3.22 m) when a closure against the same target counted as
+    confirmation."""
+    from fhslam.geometry import relative
+
+    log = simulate(load_world("ring"), seed=1, laps=2)
+    slam = GraphFastHoughSLAM()
+    r = run_backend(slam, log)
+    steps = slam.keyframe_steps
+    assert len(slam.accepted_loops) >= 100  # measured 275 (81 before)
+    for lc in slam.accepted_loops:
+        true = relative(log.truth[steps[lc.old]], log.truth[steps[lc.new]])
+        assert np.hypot(*(lc.pose[:2] - true[:2])) <= 0.3, (lc.old, lc.new)  # measured <= 0.03 m
+    assert ate(r.poses, log.truth).rmse <= 0.2  # measured 0.107 m (odometry 14 m)
+
+
 def test_a_candidate_that_failed_for_the_previous_keyframe_waits_a_keyframe(
     three_laps, monkeypatch
 ):
@@ -302,7 +334,7 @@ def _relations_error(real_data, name, odometry_noise_seed=None, drop_fraction=0.
 REAL_LOGS = {
     "intel": (0.05, 0.0140),
     "aces": (0.06, 0.0348),
-    "mit-csail": (0.06, 0.0268),
+    "mit-csail": (0.06, 0.0281),
     "fr079": (0.08, 0.0301),
     "fr-clinic": (0.15, 1.18),
 }
@@ -344,18 +376,18 @@ def test_the_hospitals_relations_under_a_minute_hold(real_data):
 def test_mit_csail_does_not_turn_on_the_last_bit(real_data, seed):
     """The odometry multiplied by (1 + 1e-15 ε): before closures that move a keyframe far
     waited for an independent one, seed 2 gave 0.394 m instead of 0.043 m; measured now
-    0.0268-0.0270 m for seeds 1, 2 and unperturbed."""
+    0.0269, 0.0281 and 0.0281 m for seeds 1, 2 and unperturbed."""
     e = _relations_error(real_data, "mit-csail", odometry_noise_seed=seed)
     assert e.trans_mean <= 0.035, f"seed {seed}: {e.trans_mean:.4f} m"
 
 
-@pytest.mark.parametrize(("name", "every_scan"), [("mit-csail", 0.0268), ("fr079", 0.0301)])
+@pytest.mark.parametrize(("name", "every_scan"), [("mit-csail", 0.0281), ("fr079", 0.0301)])
 def test_dropped_scans_change_little(real_data, name, every_scan):
     """10 % of the scans dropped (issue 10: no log's error may change by more than 25 % or
     1 cm). MIT CSAIL: a 5 Hz laser then turns up to 50 degrees between two scans, into space
     the local map has not seen; before the tracker matched such a scan against the previous
     one, five doubtful scans followed the odometry and forced a keyframe 14-17 degrees off:
-    0.73 m (measured now 0.0280 m). Freiburg 079: with the bag's laser mount (+0.04 m) the
+    0.73 m (measured now 0.0284 m). Freiburg 079: with the bag's laser mount (+0.04 m) the
     result swung between 0.064 m and 0.040 m (measured now 0.0308 m)."""
     e = _relations_error(real_data, name, drop_fraction=0.1)
     assert e.n_used < e.n_total  # relations at dropped scans cannot be evaluated

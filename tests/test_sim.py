@@ -23,6 +23,7 @@ from fhslam.sim import (
     odometry_from_truth,
     paper_world,
     random_world,
+    ring_world,
     route_clearance,
     simulate,
     transform_world,
@@ -232,6 +233,18 @@ def test_small_worlds_have_walls_through_the_origin_and_a_clear_loop(world):
     assert wall_distances(dense_route(world), world.walls).min() >= 1.0
     assert world.route_length == pytest.approx(24.0)
     assert load_world(world.name).walls.tolist() == world.walls.tolist()
+
+
+def test_the_ring_is_a_corridor_round_a_block_with_alcoves():
+    w = ring_world()
+    assert w.route_length == pytest.approx(150.0)
+    assert np.array_equal(w.route[0], w.route[-1])
+    assert wall_distances(dense_route(w), w.walls).min() == pytest.approx(1.25)  # centre line
+    lengths = np.hypot(w.walls[:, 2] - w.walls[:, 0], w.walls[:, 3] - w.walls[:, 1])
+    alcoves = np.sum(np.isclose(lengths, 1.0))  # each: two sides 0.8 m deep, a back 1 m wide
+    assert np.sum(np.isclose(lengths, 0.8)) == 2 * alcoves
+    assert 24 <= alcoves <= 40  # 7-13 m apart on both sides of 150 m of corridor
+    assert load_world("ring").walls.tolist() == w.walls.tolist()
 
 
 MOTIONS = [(5.0, 5.0, 0.0), (-3.3, 2.1, np.radians(37)), (0.0, -15.0, np.pi / 2)]

@@ -21,6 +21,7 @@ from fhslam.sim.world import (
     load_world,
     paper_world,
     random_world,
+    ring_world,
     route_clearance,
     transform_world,
 )
@@ -47,6 +48,7 @@ __all__ = [
     "odometry_from_truth",
     "paper_world",
     "random_world",
+    "ring_world",
     "route_clearance",
     "simulate",
     "transform_world",

@@ -15,7 +15,8 @@ four is read as a misspelling: the world is used without it and an
 Built-in worlds: ``"paper"`` (:func:`paper_world`, the paper's 18.7 x 14.0 m office),
 ``"random:SEED"`` (:func:`random_world`, held-out worlds nothing was tuned on), and two small
 worlds with walls through the origin, ``"hall"`` (:func:`hall_world`) and ``"corridor"``
-(:func:`corridor_world`). :func:`transform_world` moves a world rigidly (to check that a
+(:func:`corridor_world`), and a 150 m corridor ring, ``"ring"`` (:func:`ring_world`).
+:func:`transform_world` moves a world rigidly (to check that a
 method does not depend on where the world frame lies).
 """
 
@@ -36,7 +37,7 @@ from fhslam.geometry import compose, segment_distances, transform_points, wrap_a
 from fhslam.io.files import input_path, reading
 from fhslam.io.mapfile import MAX_COORDINATE
 
-BUILTIN_WORLDS = ("paper", "hall", "corridor", "random:SEED")
+BUILTIN_WORLDS = ("paper", "hall", "corridor", "ring", "random:SEED")
 
 WORLD_KEYS = ("name", "walls", "route", "start")
 """The keys of a world JSON object; any other is warned about and ignored."""
@@ -430,6 +431,57 @@ def corridor_world() -> World:
     )  # fmt: skip
 
 
+def _alcoved(p0, p1, outward, spacing=10.0, width=1.0, depth=0.8) -> NDArray:
+    """The wall from ``p0`` to ``p1`` with alcoves ``width`` wide and ``depth`` deep cut
+    towards ``outward``, the first ``spacing / 2`` from ``p0``, then 7-13 m apart for
+    ``spacing`` 10 (deterministic, irregular: no two stretches of wall look alike)."""
+    p0, p1, out = np.array(p0, float), np.array(p1, float), np.array(outward, float)
+    length = float(np.hypot(*(p1 - p0)))
+    u = (p1 - p0) / length
+    pts, s = [p0], spacing / 2
+    while s + width < length - 1.0:
+        a, b = p0 + u * s, p0 + u * (s + width)
+        pts += [a, a + out * depth, b + out * depth, b]
+        s += spacing * (0.7 + 0.6 * ((s * 7.3) % 1.0))
+    pts.append(p1)
+    return np.array([[*pts[k], *pts[k + 1]] for k in range(len(pts) - 1)])
+
+
+def ring_world() -> World:
+    """A corridor 2.5 m wide round a 45 x 25 m block: 150 m a lap (origin: the south-west
+    corner).
+
+    The outer wall is the 50 x 30 m rectangle from the origin, the block spans (2.5, 2.5) -
+    (47.5, 27.5); both sides of the corridor have alcoves 1 m wide and 0.8 m deep, 7-13 m
+    apart. With the default 8 m laser there are stretches where no alcove is in reach, and
+    along them only the odometry says where along the corridor the robot is. The route runs
+    along the corridor's centre line once round the block, counter-clockwise from (1.25, 1.25)
+    (heading 0.02 rad, for the reason given in :func:`hall_world`).
+
+    Coming back to its start, the robot faces south while the first keyframes faced east:
+    the right match overlaps little, and one a corridor's width off (the outer corner laid on
+    the block's corner) scores as well. The graph method must not take it
+    (``tests/test_graphslam.py``).
+    """
+    w, h, c = 50.0, 30.0, 2.5
+    walls = [
+        _alcoved((0, 0), (w, 0), (0, -1)),
+        _alcoved((w, 0), (w, h), (1, 0)),
+        _alcoved((w, h), (0, h), (0, 1)),
+        _alcoved((0, h), (0, 0), (-1, 0)),
+        _alcoved((c, c), (c, h - c), (1, 0)),
+        _alcoved((c, h - c), (w - c, h - c), (0, -1)),
+        _alcoved((w - c, h - c), (w - c, c), (-1, 0)),
+        _alcoved((w - c, c), (c, c), (0, 1)),
+    ]
+    m = c / 2
+    route = [(m, m), (w - m, m), (w - m, h - m), (m, h - m), (m, m)]
+    return World(
+        name="ring", walls=np.vstack(walls), route=np.array(route, dtype=float),
+        start=np.array([m, m, 0.02]),
+    )  # fmt: skip
+
+
 def _inside_polygon(p: NDArray, poly: NDArray) -> NDArray[np.bool_]:
     """Even-odd rule: which points ``p`` (N, 2) lie inside the closed polygon ``poly`` (V, 2)."""
     a, b = poly, np.roll(poly, -1, axis=0)
@@ -506,7 +558,8 @@ def load_world(name_or_path: str | PathLike[str]) -> World:
     Parameters
     ----------
     name_or_path : str or path-like
-        ``"paper"``, ``"hall"``, ``"corridor"``, ``"random:SEED"`` (e.g. ``"random:3"``),
+        ``"paper"``, ``"hall"``, ``"corridor"``, ``"ring"``, ``"random:SEED"`` (e.g.
+        ``"random:3"``),
         or the path of a JSON file
         ``{"name": ..., "walls": [[x1, y1, x2, y2], ...], "route": [[x, y], ...],
         "start": [x, y, theta]}`` (``start`` optional).
@@ -529,7 +582,12 @@ def load_world(name_or_path: str | PathLike[str]) -> World:
     """
     text = str(name_or_path)
     if not isinstance(name_or_path, PathLike):
-        builtin = {"paper": paper_world, "hall": hall_world, "corridor": corridor_world}
+        builtin = {
+            "paper": paper_world,
+            "hall": hall_world,
+            "corridor": corridor_world,
+            "ring": ring_world,
+        }
         if text in builtin:
             return builtin[text]()
         if text.startswith("random:"):

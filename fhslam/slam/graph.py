@@ -28,8 +28,10 @@ line describes. What this module adds, each measured in the README:
    optimisation a closure whose error stays above ``loop_max_chi2`` (Mahalanobis) is
    switched off and the graph optimised again, so a few wrong closures cannot bend the
    trajectory. A closure that would move its keyframe far (``loop_confirm_distance``) waits
-   until one from an independent query agrees with it: one door off in a corridor, a single
-   match looks as good as the right one.
+   until an independent one agrees with it, from a query and against a target that share no
+   keyframe with its own: one door off in a corridor, or a corridor's width off where a
+   corridor meets its start again, a single match looks as good as the right one, and so does
+   the next query's against the same target.
 5. **The map of reference lines** is built at the end by Loop 2 itself: each keyframe's fast
    Hough lines, placed at its optimised pose, are matched with and merged into the map
    (Fig. 11) - the paper's map, from better poses.
@@ -165,13 +167,17 @@ class GraphSlamParams:
     loop_confirm_distance : float
         A closure that would move its keyframe by more than this (metres)...
     loop_confirm_deg : float
-        ... or turn it by more than this (degrees) is held until a closure from a query
-        that shares no keyframe with it, within ``loop_confirm_window`` keyframes, agrees:
-        carried along the graph to the same keyframe, the two place it within
-        ``loop_consistency`` metres and ``loop_consistency_deg`` degrees. A corridor lined
-        with doors matches as well one door further, and so does the next keyframe's query,
-        which shares two thirds of its points; two queries apart rarely agree on the
-        wrong door (MIT CSAIL: the relation error no longer turns on the last bit).
+        ... or turn it by more than this (degrees) is held until an independent closure
+        within ``loop_confirm_window`` keyframes agrees: its query shares no keyframe with
+        this one's, nor its target with this one's target (:meth:`GraphFastHoughSLAM.
+        _independent`), and carried along the graph to the same keyframe, the two place it
+        within ``loop_consistency`` metres and ``loop_consistency_deg`` degrees. A corridor
+        lined with doors matches as well one door further, and so does the next keyframe's
+        query, which shares two thirds of its points (MIT CSAIL: the relation error no longer
+        turns on the last bit). Where a corridor ring comes back to its start, two queries
+        apart matched the *same* start keyframes a corridor's width off, alike (scores 0.55
+        and 0.72, 3.5 m off): a closure against the same target is no independent
+        evidence.
     loop_consistency : float
         See ``loop_confirm_deg``.
     loop_consistency_deg : float
@@ -667,7 +673,7 @@ class GraphFastHoughSLAM:
         for j in cands[:1] if tracking else cands:
             if p.loop_skip_repeats and not tracking and self._failed.get(j) == i - 1:
                 continue  # failed for the previous keyframe: tried again the next time
-            members = range(max(0, j - 3), min(j + 4, i - p.loop_min_gap + 1))
+            members = self._target(j, i)
             cached = self.loop_targets.get(
                 poses, members, lambda j=j, m=members: self._submap(j, m, poses)
             )
@@ -697,7 +703,9 @@ class GraphFastHoughSLAM:
         self._pending = [h for h in self._pending if i - h[1] <= p.loop_confirm_window]
         for h in held:
             # from a query that shares no keyframe with this one (queries span 3 keyframes)
-            support = [g for g in self._pending if g[1] <= i - 3 and self._agree(g, h, poses)]
+            support = [
+                g for g in self._pending if self._independent(g, h) and self._agree(g, h, poses)
+            ]
             if support:
                 for g in [*support, h]:
                     closed.append(self._add_loop(g[0], g[1], g[2], g[3], g[4]))
@@ -713,6 +721,17 @@ class GraphFastHoughSLAM:
         e = self._graph.add_edge(j, i, z, info, self.params.loop_kernel, kind="loop")
         self._loops.append(LoopClosure(j, i, z, score, e))
         return e
+
+    def _target(self, j: int, i: int) -> range:
+        """The keyframes of candidate ``j``'s target for keyframe ``i``'s query: ``j`` and
+        three on either side, none within ``loop_min_gap`` of ``i``."""
+        return range(max(0, j - 3), min(j + 4, i - self.params.loop_min_gap + 1))
+
+    def _independent(self, g, h) -> bool:
+        """Whether held closures ``g`` and ``h`` share no keyframe: neither in their queries
+        (keyframes ``i - 2 .. i``) nor in their targets (:meth:`_target`)."""
+        a, b = self._target(g[0], g[1]), self._target(h[0], h[1])
+        return abs(g[1] - h[1]) >= 3 and max(a.start, b.start) >= min(a.stop, b.stop)
 
     def _agree(self, g, h, poses) -> bool:
         """Whether held closures ``g`` and ``h`` place keyframe ``h``'s ``i`` alike (``g``'s

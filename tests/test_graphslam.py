@@ -66,7 +66,6 @@ def test_a_closure_that_moves_its_keyframe_far_waits_for_an_independent_one():
         assert not slam._agree(g, (1, 11, None, None, 0.6, compose(same, off)), poses)
 
 
-
 def test_closures_confirm_each_other_only_when_they_share_no_keyframe():
     """Independent: the queries (keyframes i-2..i) apart, and the targets (candidate j and
     three on either side) too."""

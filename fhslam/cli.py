@@ -497,6 +497,11 @@ def _log_arguments(p: argparse.ArgumentParser) -> None:
     )
 
 
+WORLDS_HELP = "'paper', 'hall', 'corridor', 'ring', 'random:SEED'"
+"""The built-in worlds (:data:`fhslam.sim.world.BUILTIN_WORLDS`), named here so that the help
+does not import the simulator."""
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog="fhslam",
@@ -505,7 +510,7 @@ def build_parser() -> argparse.ArgumentParser:
     sub = parser.add_subparsers(dest="command", required=True)
 
     p = sub.add_parser("simulate", help="simulate a world: CARMEN log plus ground truth")
-    p.add_argument("world", help="built-in world ('paper', 'random:SEED') or a world JSON file")
+    p.add_argument("world", help=f"built-in world ({WORLDS_HELP}) or a world JSON file")
     p.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
     p.add_argument("--log", required=True, type=Path, help="output CARMEN log (.clf)")
     p.add_argument("--truth", required=True, type=Path, help="output truth file")
@@ -590,9 +595,7 @@ def build_parser() -> argparse.ArgumentParser:
         help="benchmark relations file (timestamp1 timestamp2 x y z roll pitch yaw), or a "
         "dataset name (intel, aces, ...) to use its relations",
     )
-    p.add_argument(
-        "--world", help="built-in world ('paper', 'random:SEED') or world JSON file (--truth)"
-    )
+    p.add_argument("--world", help=f"built-in world ({WORLDS_HELP}) or world JSON file (--truth)")
     p.add_argument("--map", type=Path, help="map JSON of the run (needs --world and --truth)")
     p.add_argument(
         "--max-diff",

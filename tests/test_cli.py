@@ -878,3 +878,10 @@ def test_simulate_shows_progress_on_a_long_route_unless_quiet(tmp_path):
     assert r.returncode == 0 and r.stderr == ""
     r = run("simulate", "paper", "--log", str(tmp_path / "p.clf"), "--truth", str(tmp_path / "t"))
     assert r.returncode == 0 and r.stderr == ""  # 916 scans: no bar
+
+
+def test_the_help_names_every_built_in_world():
+    from fhslam.cli import WORLDS_HELP
+    from fhslam.sim.world import BUILTIN_WORLDS
+
+    assert ", ".join(f"'{w}'" for w in BUILTIN_WORLDS) == WORLDS_HELP

@@ -41,17 +41,17 @@ def test_simulate_writes_a_log_that_reads_back_exactly(tmp_path):
     assert np.abs(log.odometry[-1, :2] - poses[-1, :2]).max() > 0.1
 
 
+BOX = {
+    "name": "box",
+    "walls": [[0, 0, 6, 0], [6, 0, 6, 4], [6, 4, 0, 4], [0, 4, 0, 0]],
+    "route": [[1, 1], [5, 1], [5, 3]],
+}
+"""A 6 x 4 m room and a route through it (a world file's keys)."""
+
+
 def test_simulate_accepts_a_world_file(tmp_path):
     world = tmp_path / "box.json"
-    world.write_text(
-        json.dumps(
-            {
-                "name": "box",
-                "walls": [[0, 0, 6, 0], [6, 0, 6, 4], [6, 4, 0, 4], [0, 4, 0, 0]],
-                "route": [[1, 1], [5, 1], [5, 3]],
-            }
-        )
-    )
+    world.write_text(json.dumps(BOX))
     out = tmp_path / "box.clf"
     assert main(["simulate", str(world), "--log", str(out), "--truth", str(tmp_path / "t")]) == 0
     assert len(read_carmen(out)) > 10
@@ -79,16 +79,7 @@ def test_slam_odometry_of_a_log_counting_turns_stays_in_minus_pi_pi(tmp_path):
 
 def test_simulate_wraps_the_start_heading_of_a_world_file(tmp_path):
     world = tmp_path / "box.json"
-    world.write_text(
-        json.dumps(
-            {
-                "name": "box",
-                "walls": [[0, 0, 6, 0], [6, 0, 6, 4], [6, 4, 0, 4], [0, 4, 0, 0]],
-                "route": [[1, 1], [5, 1], [5, 3]],
-                "start": [1, 1, 7.0],
-            }
-        )
-    )
+    world.write_text(json.dumps({**BOX, "start": [1, 1, 7.0]}))
     log, truth = tmp_path / "box.clf", tmp_path / "t.txt"
     assert main(["simulate", str(world), "--log", str(log), "--truth", str(truth), "--quiet"]) == 0
     _, poses = read_trajectory(truth)

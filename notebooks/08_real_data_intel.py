@@ -142,7 +142,7 @@ summary(log, t1, t2)
 # ## 2 · Three runs: raw odometry, the paper's procedure, and the pose graph
 #
 # The raw odometry is computed here (a fraction of a second). The two SLAM runs over the whole log
-# take about 20 s (`"fht"`) and about a minute (`"graph"`) on this 2-core machine (section 6), too
+# take about 30 s (`"fht"`) and about 17 s (`"graph"`) on this 2-core machine (section 6), too
 # long for a notebook, so they were made once by the `fhslam` command, and their files in
 # `notebooks/results/` are loaded here: the trajectory (`timestamp x y theta`, one line per scan;
 # `fhslam.io.read_trajectory`), the map of reference lines (`fhslam.io.read_map`) and, for the

@@ -21,6 +21,7 @@ from fhslam.sim import (
     hall_world,
     load_world,
     odometry_from_truth,
+    offices_world,
     paper_world,
     random_world,
     ring_world,
@@ -245,6 +246,19 @@ def test_the_ring_is_a_corridor_round_a_block_with_alcoves():
     assert np.sum(np.isclose(lengths, 0.8)) == 2 * alcoves
     assert 24 <= alcoves <= 40  # 7-13 m apart on both sides of 150 m of corridor
     assert load_world("ring").walls.tolist() == w.walls.tolist()
+
+
+def test_the_offices_route_drives_its_corridor_both_ways():
+    w = offices_world()
+    assert np.array_equal(w.route[0], w.route[-1])
+    assert wall_distances(dense_route(w), w.walls).min() >= 0.5
+    rho = np.array([line_through(x[:2], x[2:])[0] for x in w.walls])
+    assert (rho < 1e-12).sum() >= 2  # the outer walls on x = 0 and y = 0
+    step = np.diff(w.route, axis=0)
+    corridor = (np.abs(step[:, 0]) > 3) & (np.abs(w.route[1:, 1] - 6.1) < 0.2)  # y 5.9-6.3
+    assert set(np.sign(step[corridor, 0])) == {-1.0, 1.0}  # east and back west
+    assert step[corridor, 0].min() == -18.0  # the whole corridor back
+    assert load_world("offices").walls.tolist() == w.walls.tolist()
 
 
 MOTIONS = [(5.0, 5.0, 0.0), (-3.3, 2.1, np.radians(37)), (0.0, -15.0, np.pi / 2)]

@@ -15,7 +15,8 @@ four is read as a misspelling: the world is used without it and an
 Built-in worlds: ``"paper"`` (:func:`paper_world`, the paper's 18.7 x 14.0 m office),
 ``"random:SEED"`` (:func:`random_world`, held-out worlds nothing was tuned on), and two small
 worlds with walls through the origin, ``"hall"`` (:func:`hall_world`) and ``"corridor"``
-(:func:`corridor_world`), and a 150 m corridor ring, ``"ring"`` (:func:`ring_world`).
+(:func:`corridor_world`), a 150 m corridor ring, ``"ring"`` (:func:`ring_world`), and an
+office floor whose route drives its corridor both ways, ``"offices"`` (:func:`offices_world`).
 :func:`transform_world` moves a world rigidly (to check that a
 method does not depend on where the world frame lies).
 """
@@ -37,7 +38,7 @@ from fhslam.geometry import compose, segment_distances, transform_points, wrap_a
 from fhslam.io.files import input_path, reading
 from fhslam.io.mapfile import MAX_COORDINATE
 
-BUILTIN_WORLDS = ("paper", "hall", "corridor", "ring", "random:SEED")
+BUILTIN_WORLDS = ("paper", "hall", "corridor", "ring", "offices", "random:SEED")
 
 WORLD_KEYS = ("name", "walls", "route", "start")
 """The keys of a world JSON object; any other is warned about and ignored."""
@@ -482,6 +483,59 @@ def ring_world() -> World:
     )  # fmt: skip
 
 
+def offices_world() -> World:
+    """A 20 x 12 m office floor (origin: the south-west corner): an east-west corridor 2 m
+    wide (y 5-7 m) between four rooms 5 m wide on each side, doors 1 m wide, three boxes
+    (two turned by 15 and -20 degrees).
+
+    The route starts at the corridor's west end, goes east, loops through the second room on
+    the south side and the third on the north side, turns at the corridor's east end and
+    drives the corridor back west to the start (64 m; a closed route). On the way back its
+    180-degree laser looks the other way: what it sees, the keyframes a few metres ahead of it
+    saw on the way out, not the ones where it stands. The start heading is 0.03 rad, for the
+    reason given in :func:`hall_world`.
+    """
+    w, h = 20.0, 12.0
+    walls = [_polyline((0, 0), (w, 0), (w, h), (0, h), (0, 0))]
+    for y, side, door in ((5.0, -1.0, 2.0), (7.0, 1.0, 2.5)):  # corridor walls, room walls
+        x = 0.0
+        for k in range(4):
+            walls.append(np.array([[x, y, 5.0 * k + door, y]]))
+            x = 5.0 * k + door + 1.0
+        walls.append(np.array([[x, y, w, y]]))
+        walls += [np.array([[5.0 * k, y, 5.0 * k, y + 5.0 * side]]) for k in (1, 2, 3)]
+    walls += [
+        box_walls(3.0, 2.0, 1.2, 0.6, 15.0),
+        box_walls(12.4, 9.6, 0.6, 0.6),
+        box_walls(17.0, 2.5, 1.6, 0.8, -20.0),
+    ]
+    route = [
+        (1.0, 6.0),
+        (7.5, 6.0),  # the corridor east
+        (7.5, 3.5),
+        (9.0, 2.0),
+        (6.0, 1.5),
+        (6.5, 4.0),
+        (7.5, 4.0),
+        (7.5, 6.0),  # a south room
+        (13.0, 6.0),
+        (13.0, 8.5),
+        (14.0, 10.5),
+        (11.0, 10.8),
+        (11.5, 8.5),
+        (13.0, 8.5),
+        (13.0, 6.0),  # north
+        (19.0, 6.0),
+        (19.0, 6.2),
+        (1.0, 6.2),
+        (1.0, 6.0),  # the east end, and back west
+    ]
+    return World(
+        name="offices", walls=np.vstack(walls), route=np.array(route, dtype=float),
+        start=np.array([1.0, 6.0, 0.03]),
+    )  # fmt: skip
+
+
 def _inside_polygon(p: NDArray, poly: NDArray) -> NDArray[np.bool_]:
     """Even-odd rule: which points ``p`` (N, 2) lie inside the closed polygon ``poly`` (V, 2)."""
     a, b = poly, np.roll(poly, -1, axis=0)
@@ -558,8 +612,8 @@ def load_world(name_or_path: str | PathLike[str]) -> World:
     Parameters
     ----------
     name_or_path : str or path-like
-        ``"paper"``, ``"hall"``, ``"corridor"``, ``"ring"``, ``"random:SEED"`` (e.g.
-        ``"random:3"``),
+        ``"paper"``, ``"hall"``, ``"corridor"``, ``"ring"``, ``"offices"``, ``"random:SEED"``
+        (e.g. ``"random:3"``),
         or the path of a JSON file
         ``{"name": ..., "walls": [[x1, y1, x2, y2], ...], "route": [[x, y], ...],
         "start": [x, y, theta]}`` (``start`` optional).
@@ -587,6 +641,7 @@ def load_world(name_or_path: str | PathLike[str]) -> World:
             "hall": hall_world,
             "corridor": corridor_world,
             "ring": ring_world,
+            "offices": offices_world,
         }
         if text in builtin:
             return builtin[text]()

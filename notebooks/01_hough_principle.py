@@ -198,7 +198,8 @@ print(check_accumulator_reading("b", acc, thetas, rhos))
 # m ahead: $(\rho, \theta)$ and $(-\rho, \theta + 180°)$ are the same line, so a wall whose
 # normal is near 0° peaks at both edges.
 
-# %% tags=["nbval-check-output"]
+# %%
+# NBVAL_CHECK_OUTPUT
 from fhslam.geometry import normalize_line
 from fhslam.metrics import line_difference
 from fhslam.sim import true_lines
@@ -243,7 +244,8 @@ print(check_accumulator_cells(solution_cells, RHO_STEP, THETA_STEP_DEG, RHO_MAX,
 # the number of angles, and the memory with the whole $(\rho, \theta)$ plane. The fast Hough
 # transform of the paper votes only in a few degrees around the dominant slope of each cluster.
 
-# %% tags=["nbval-check-output"]
+# %%
+# NBVAL_CHECK_OUTPUT
 from fhslam.extraction import ExtractionParams
 
 p = ExtractionParams()

@@ -84,7 +84,8 @@ plt.show()
 fig04_clusters(log, k)
 plt.show()
 
-# %% tags=["nbval-check-output"]
+# %%
+# NBVAL_CHECK_OUTPUT
 params = ExtractionParams()
 points, beams = log.scan(k).points()  # fhslam.scan.scan_to_points: invalid beams dropped
 labels = cluster_scan(points, params.cluster_gap)
@@ -126,7 +127,8 @@ print(check_point_spacing(solution_spacing))
 # Too small a gap cuts a wall seen at a grazing angle into pieces; too large a gap joins walls
 # across a doorway. The count of clusters for a few thresholds:
 
-# %% tags=["nbval-check-output"]
+# %%
+# NBVAL_CHECK_OUTPUT
 for gap in (0.05, 0.1, 0.2, 0.3, 0.5, 1.0, 2.0):
     n = np.bincount(cluster_scan(points, gap))
     print(

@@ -155,7 +155,8 @@ ax.set(
 )
 plt.show()
 
-# %% tags=["nbval-check-output"]
+# %%
+# NBVAL_CHECK_OUTPUT
 print(f"dominant slope {np.degrees(phi[0]):.1f} deg with {support[0]:.0f} (smoothed) pair votes")
 print(
     f"peak: rho = {peaks.rho[0]:.3f} m, theta = {np.degrees(peaks.theta[0]) % 360:.1f} deg, {peaks.votes[0]} votes"
@@ -203,7 +204,8 @@ print(check_window_reading("a", dense, phi))
 fig05_lines(log, k)
 plt.show()
 
-# %% tags=["nbval-check-output"]
+# %%
+# NBVAL_CHECK_OUTPUT
 lines = extract_lines(points, params, pose=(0, 0, 0))
 for i, line in enumerate(lines, 1):
     print(
@@ -270,7 +272,8 @@ from fhslam.experiments.bench import run_bench, format_table
 QUICK = True  # False: 25 scans per world as in `fhslam bench`
 rows = run_bench(scans_per_world=6 if QUICK else 25, repeats=3 if QUICK else 9, progress=False)
 
-# %% tags=["nbval-check-output"]
+# %%
+# NBVAL_CHECK_OUTPUT
 print(
     f"{'extractor':<28} {'TruePos':>8} {'FalsePos':>9} {'rms drho cm':>12} {'rms dtheta deg':>15}"
 )

@@ -64,7 +64,8 @@ from fhslam.figures import fig06_line_attributes, line_attributes_example
 fig06_line_attributes()
 plt.show()
 
-# %% tags=["nbval-check-output"]
+# %%
+# NBVAL_CHECK_OUTPUT
 line6, pose6 = line_attributes_example()
 print(line6.observed_from(pose6))
 
@@ -108,7 +109,8 @@ from fhslam.figures import fig07_to_10_similarity
 fig07_to_10_similarity()
 plt.show()
 
-# %% tags=["nbval-check-output"]
+# %%
+# NBVAL_CHECK_OUTPUT
 from fhslam.figures import similarity_examples
 from fhslam.matching import MatchParams, similarity
 
@@ -177,7 +179,8 @@ print(check_failing_conditions(my_prediction, south, north))
 # Parallel, 10 cm apart and overlapping: (b), (c), (d) hold. dir +1 and -1: (a) fails.
 print(check_failing_conditions("a", south, north))
 
-# %% tags=["nbval-check-output"]
+# %%
+# NBVAL_CHECK_OUTPUT
 print(similarity(south, north))
 
 # %% [markdown]
@@ -220,7 +223,8 @@ ax.set(
 ax.legend()
 plt.show()
 
-# %% tags=["nbval-check-output"]
+# %%
+# NBVAL_CHECK_OUTPUT
 moved = np.hypot(*(log.truth[205, :2] - log.truth[200, :2]))
 print(f"{len(second)} lines in scan 205, {len(first)} in scan 200; the robot moved {moved:.2f} m")
 for i, row in enumerate(m["similar"]):

@@ -66,7 +66,8 @@ from fhslam.matching import merge
 fig11_merging()
 plt.show()
 
-# %% tags=["nbval-check-output"]
+# %%
+# NBVAL_CHECK_OUTPUT
 ef, ab = merging_example()
 print("reference EF:", ef)
 print("new AB:      ", ab)
@@ -130,7 +131,8 @@ match = match_lines(transform_lines(observed, predicted), references, wide, pose
 pairs = [(i, int(j)) for i, j in enumerate(match) if j >= 0]
 print(f"{len(observed)} lines observed, {len(pairs)} matched to the reference lines")
 
-# %% tags=["nbval-check-output"]
+# %%
+# NBVAL_CHECK_OUTPUT
 print("iterations  position error [cm]  heading error [deg]")
 for it in range(0, 5):
     cal = calibrate_pose(observed, references, pairs, predicted, iterations=it)
@@ -186,7 +188,8 @@ calibration_explorer(log, k)
 # 10 m long and 2 m wide (walls at y = 0 and y = 2 m), the robot in its middle at (5, 1, 0),
 # and an odometry 40 cm off along the corridor, 10 cm across it and 0.02 rad (1.1°) in heading:
 
-# %% tags=["nbval-check-output"]
+# %%
+# NBVAL_CHECK_OUTPUT
 from fhslam.lines import line_from_points
 
 corridor = [
@@ -224,7 +227,8 @@ print(check_corridor_pose(my_pose, seen, corridor, pairs, wrong))
 solution_pose = (5.4, 1.0, 0.0)
 print(check_corridor_pose(solution_pose, seen, corridor, pairs, wrong))
 
-# %% tags=["nbval-check-output"]
+# %%
+# NBVAL_CHECK_OUTPUT
 cal = calibrate_pose(seen, corridor, pairs, wrong)
 print("calibrated:", cal.pose.round(3), "  constrained (weak, strong direction):", cal.constrained)
 

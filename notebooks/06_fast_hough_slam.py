@@ -129,7 +129,8 @@ print(check_drift_ratio(my_prediction, result.poses, log.odometry, log.truth))
 # Metres of odometry drift against the centimetres to which the matched lines fix a pose: tens.
 print(check_drift_ratio("c", result.poses, log.odometry, log.truth))
 
-# %% tags=["nbval-check-output"]
+# %%
+# NBVAL_CHECK_OUTPUT
 from fhslam.metrics import ate, map_coverage, map_error, rpe
 from fhslam.sim import observed_wall_points
 
@@ -220,7 +221,8 @@ slam_noise_explorer(SEED)
 # boxes; 3 laps, 2–6 m odometry drift), then the paper world with 10 % of the scans dropped and
 # 5 % clutter returns (people, chairs: short of the wall).
 
-# %% tags=["nbval-check-output"]
+# %%
+# NBVAL_CHECK_OUTPUT
 from fhslam.sim import OdometryNoise, degrade, load_world, simulate
 
 worlds = [f"random:{s}" for s in (range(101, 105) if QUICK else range(101, 121))]

@@ -72,7 +72,8 @@ from fhslam.experiments.bench import run_bench
 
 rows = run_bench(scans_per_world=10, repeats=3, progress=False)
 
-# %% tags=["nbval-check-output"]
+# %%
+# NBVAL_CHECK_OUTPUT
 print(
     f"{'extractor':<28} {'TruePos':>8} {'FalsePos':>9} {'rms drho cm':>12} {'rms dtheta deg':>15}"
 )
@@ -126,7 +127,8 @@ print(
 # `fhslam.experiments.compare.load_sweep`. Run the command from the repository's root to
 # recompute it; the pinned run at the end of this section checks the file against the code.
 
-# %% tags=["nbval-check-output"]
+# %%
+# NBVAL_CHECK_OUTPUT
 from fhslam.experiments.compare import LABELS, format_summary, load_sweep
 
 SWEEP_FILE = Path("results") / "sweep_paper.csv"  # beside this notebook (student-copy copies it)
@@ -190,7 +192,8 @@ plt.show()
 # the map's segments to the nearest true wall, `fhslam.metrics.map_error`) and the median time per
 # step.
 
-# %% tags=["nbval-check-output"]
+# %%
+# NBVAL_CHECK_OUTPUT
 print(format_summary(sweep))
 
 
@@ -270,7 +273,8 @@ print(check_classical_reading("b", sweep))
 # its load at the time. The ratio of two methods' times on the same log cancels both, so the
 # last column is the one to compare (median over the 60 logs). `fhslam bench` measures steps per second on your machine.
 
-# %% tags=["nbval-check-output"]
+# %%
+# NBVAL_CHECK_OUTPUT
 ms = {(r.level, r.seed, r.method): r.ms_per_step for r in sweep}
 logs = [(lv, s) for lv in levels for s in seeds]
 print(f"{'method':26} {'steps/s':>8} {'ms/step':>8}  time per step / FH-SLAM's on the same log")
@@ -286,7 +290,8 @@ for m in methods:
 # the paper's comparison (nbval checks these numbers, so a change of the code that the file does
 # not follow shows here).
 
-# %% tags=["nbval-check-output"]
+# %%
+# NBVAL_CHECK_OUTPUT
 from fhslam.experiments.compare import one_run
 
 saved = {r.method: r for r in sweep if (r.level, r.seed) == ("medium", SEED)}

@@ -119,7 +119,8 @@ print(f"fhslam {fhslam.__version__}")
 # repository (`../shared/data`); if none has them, `fhslam slam intel --download` (or
 # `find_dataset("intel", download=True)`) fetches them and checks their sha256.
 
-# %% tags=["nbval-check-output"]
+# %%
+# NBVAL_CHECK_OUTPUT
 log = load_log("intel")
 t1, t2, rel = read_relations(find_dataset("intel", kind="relations"))
 
@@ -164,7 +165,8 @@ summary(log, t1, t2)
 # trajectories and maps; the keyframe graph stays in the back end (`GraphFastHoughSLAM`, driven by
 # `fhslam.pipeline.run_backend`).
 
-# %% tags=["nbval-check-output"]
+# %%
+# NBVAL_CHECK_OUTPUT
 RESULTS = Path(
     "results"
 )  # notebooks/results, beside this notebook (`fhslam student-copy` copies it)
@@ -220,7 +222,8 @@ print(check_paper_vs_odometry("b", res_odo, res_fht, t1, t2, rel))
 #
 # Mean ± standard deviation over all relations of the log (`fhslam.metrics.relations_error`).
 
-# %% tags=["nbval-check-output"]
+# %%
+# NBVAL_CHECK_OUTPUT
 def relations_table(rows, t1, t2, rel):
     print(f"{'method':34} {'trans [m]':>17} {'rot [deg]':>15} {'used':>10}")
     out = {}
@@ -435,7 +438,8 @@ def span_plot(rows, t1, t2, rel, title, floor=(1e-4, 1e-3), min_span=0.05):
 span_plot(rows_intel, t1, t2, rel, "Intel: relation error against time span")
 
 
-# %% tags=["nbval-check-output"]
+# %%
+# NBVAL_CHECK_OUTPUT
 def span_summary(rows, t1, t2, rel, bands=((0, 5), (5, 60), (60, np.inf))):
     head = "".join(f"{f'{a:g}-{b:g} s':>15}" for a, b in bands)
     print(f"{'mean trans error [m]':34}{head}")
@@ -529,12 +533,14 @@ timing_table(
 # same defaults as on Intel, loaded from the files the commands of section 2 made with
 # `mit-csail`.
 
-# %% tags=["nbval-check-output"]
+# %%
+# NBVAL_CHECK_OUTPUT
 log_mit = load_log("mit-csail")
 t1_mit, t2_mit, rel_mit = read_relations(find_dataset("mit-csail", kind="relations"))
 summary(log_mit, t1_mit, t2_mit)
 
-# %% tags=["nbval-check-output"]
+# %%
+# NBVAL_CHECK_OUTPUT
 res_mit = {
     "raw odometry": run_slam(log_mit, "odometry"),
     'FH-SLAM (paper, "fht")': load_run("mit-csail", "fht"),
@@ -551,7 +557,8 @@ graph_summary(graph_mit, res_mit['FH-SLAM graph ("graph")'])
 # procedure (its line matching is gated at 5°), 0.34° for the scan-to-map tracker, whose
 # correlative search covers the odometry's heading error.
 
-# %% tags=["nbval-check-output"]
+# %%
+# NBVAL_CHECK_OUTPUT
 for name, res in res_mit.items():
     s, tr, rd = span_errors(res, t1_mit, t2_mit, rel_mit)
     short = s < 0.3
@@ -572,7 +579,8 @@ plt.show()
 # %%
 span_plot(res_mit, t1_mit, t2_mit, rel_mit, "MIT CSAIL: relation error against time span")
 
-# %% tags=["nbval-check-output"]
+# %%
+# NBVAL_CHECK_OUTPUT
 span_summary(res_mit, t1_mit, t2_mit, rel_mit)
 
 # %% [markdown]

@@ -62,8 +62,9 @@
 # - **Edges weighted by their information:** the edge between consecutive keyframes carries the
 #   point-to-line refinement's 3 × 3 information plus a weak odometry prior — in a corridor the
 #   scan constrains nothing along the axis, and the edge says so.
-# - **Verified loop closures:** each finished keyframe is matched against old keyframes near it
-#   (the search radius and window grow with the distance travelled since the last closure); a
+# - **Verified loop closures:** each finished keyframe is matched against old keyframes that
+#   looked at the same place (the mean of each keyframe's points nearest the mean of its own; the
+#   search radius and window grow with the distance travelled since the last closure); a
 #   match enters the graph only with a high enough score and enough points on a line at a small
 #   rms distance, as a robust (Cauchy) edge. After each optimisation a closure whose error stays
 #   too large is switched off and the graph optimised again, so a few wrong closures cannot bend
@@ -143,7 +144,7 @@ summary(log, t1, t2)
 # ## 2 · Three runs: raw odometry, the paper's procedure, and the pose graph
 #
 # The raw odometry is computed here (a fraction of a second). The two SLAM runs over the whole log
-# take about 30 s (`"fht"`) and about 17 s (`"graph"`) on this 2-core machine (section 6), too
+# take about 30 s (`"fht"`) and about 16 s (`"graph"`) on this 2-core machine (section 6), too
 # long for a notebook, so they were made once by the `fhslam` command, and their files in
 # `notebooks/results/` are loaded here: the trajectory (`timestamp x y theta`, one line per scan;
 # `fhslam.io.read_trajectory`), the map of reference lines (`fhslam.io.read_map`) and, for the
@@ -267,9 +268,9 @@ graph_summary(graph, res_graph)
 # | Cartographer | 0.0229 ± 0.0239 | Hess et al. 2016, Table II |
 #
 # The paper's procedure reduces the odometry's 7.4 m to 2.8 m but stays at metres: globally it is
-# not a usable map. The graph method brings Intel to 0.014 ± 0.012 m and 0.23°, with 622 loop
-# closures, all still active in the end (the run switches off any it finds inconsistent after
-# optimising). That is below the published graph-mapping and Cartographer numbers — but read it
+# not a usable map. The graph method brings Intel to 0.014 ± 0.012 m and 0.23°, with 633 loop
+# closures, all but one still active in the end (the run switches off any it finds inconsistent
+# after optimising). That is below the published graph-mapping and Cartographer numbers — but read it
 # with two caveats: Intel is a *development* log, the defaults were developed on it; and the
 # published numbers come from other implementations on other machines.
 
@@ -519,7 +520,7 @@ timing_table(
     log,
     {
         'FH-SLAM (paper, "fht")': 30.1,
-        'FH-SLAM graph ("graph")': 17.2,
+        'FH-SLAM graph ("graph")': 16.0,
         "Cartographer (Hess 2016, reported)": 179.0,
     },
 )
@@ -584,11 +585,11 @@ span_plot(res_mit, t1_mit, t2_mit, rel_mit, "MIT CSAIL: relation error against t
 span_summary(res_mit, t1_mit, t2_mit, rel_mit)
 
 # %% [markdown]
-# The graph method brings mit-csail, with the same defaults as Intel, to 0.028 ± 0.028 m and 0.35°
+# The graph method brings mit-csail, with the same defaults as Intel, to 0.027 ± 0.023 m and 0.35°
 # over all relations, against 0.77 m for the paper's procedure and 1.68 m for the raw odometry —
-# 0.025 m below 5 s (0.044 m for the paper's procedure), 0.086 m between 5 s and a minute (2.1 m;
-# only 27 relations) and 0.047 m over more than a minute (7.9 m). All its 51 accepted loop
-# closures stay active. The run took 4.8 s on this machine, about 90× faster than real time (the
+# 0.025 m below 5 s (0.044 m for the paper's procedure), 0.042 m between 5 s and a minute (2.1 m;
+# only 27 relations) and 0.041 m over more than a minute (7.9 m). All its 185 accepted loop
+# closures stay active. The run took 5.0 s on this machine, about 85× faster than real time (the
 # table below). This log is where the method was least robust: before closures that move a
 # keyframe far had to wait for an independent one, a relative change of 1e-15 in the odometry
 # could decide a few loop closures differently and cost decimetres; `tests/test_graphslam.py` now
@@ -598,7 +599,7 @@ span_summary(res_mit, t1_mit, t2_mit, rel_mit)
 # wall-clock seconds of the commands of section 2 with mit-csail (/usr/bin/time)
 timing_table(
     log_mit,
-    {'FH-SLAM (paper, "fht")': 4.9, 'FH-SLAM graph ("graph")': 4.8},
+    {'FH-SLAM (paper, "fht")': 4.9, 'FH-SLAM graph ("graph")': 5.0},
 )
 
 # %% [markdown]
@@ -611,7 +612,7 @@ timing_table(
 # - The default graph method — scan-to-map tracking, edges weighted by their information,
 #   verified loop closures that are switched off when they disagree, and the paper's fast Hough
 #   lines merged into a map at the end — brings both logs to centimetres with the same defaults:
-#   Intel 0.014 m and 0.23°, mit-csail 0.028 m and 0.35°.
+#   Intel 0.014 m and 0.23°, mit-csail 0.027 m and 0.35°.
 # - The tracker follows mit-csail's noisy odometry heading (0.34° between consecutive scans,
 #   against 2.8° for the odometry and 2.0° for the paper's procedure); the verified loop
 #   closures are what holds relations minutes apart at centimetres.

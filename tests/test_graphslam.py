@@ -23,7 +23,7 @@ def test_loops_are_closed_and_the_drift_removed(three_laps):
     log = three_laps
     slam = GraphFastHoughSLAM()
     r = run_backend(slam, log)
-    assert len(slam.loops) >= 20  # measured 105
+    assert len(slam.loops) >= 20  # measured 104
     assert all(lc.score >= slam.params.loop_min_score for lc in slam.loops)
     assert all(lc.new - lc.old >= slam.params.loop_min_gap for lc in slam.loops)
     odometry = ate(log.odometry, log.truth).rmse  # 2.3 m
@@ -33,7 +33,7 @@ def test_loops_are_closed_and_the_drift_removed(three_laps):
 
 
 def test_closures_that_agree_are_added_without_optimising(three_laps):
-    """Optimising only after closures that disagree with the estimate (χ² >= 1) saves most
+    """Optimising only after closures that disagree with the estimate (χ² >= 9) saves most
     optimisations and moves no pose by more than a few millimetres."""
 
     def run(params):
@@ -43,12 +43,12 @@ def test_closures_that_agree_are_added_without_optimising(three_laps):
         slam._optimize = lambda: count.append(1) or optimize()
         return run_backend(slam, three_laps).poses, len(count)
 
-    lazy, n_lazy = run(GraphSlamParams())  # the default: loop_optimize_chi2=1.0
+    lazy, n_lazy = run(GraphSlamParams())  # the default: loop_optimize_chi2=9.0
     eager, n_eager = run(GraphSlamParams(loop_optimize_chi2=0.0))
-    assert n_eager >= 20 and n_lazy <= 0.5 * n_eager  # measured 5 of 104 (with finish)
-    assert np.abs(lazy[:, :2] - eager[:, :2]).max() <= 0.01  # measured 2.2 mm
+    assert n_eager >= 20 and n_lazy <= 0.5 * n_eager  # measured 2 of 105 (with finish)
+    assert np.abs(lazy[:, :2] - eager[:, :2]).max() <= 0.01  # measured 4.6 mm
     truth = three_laps.truth
-    assert ate(lazy, truth).rmse <= ate(eager, truth).rmse + 0.002  # measured 1.496 vs 1.497 cm
+    assert ate(lazy, truth).rmse <= ate(eager, truth).rmse + 0.002  # measured 1.08 vs 1.01 cm
 
 
 def test_a_closure_that_moves_its_keyframe_far_waits_for_an_independent_one():
@@ -97,27 +97,23 @@ def test_a_corridor_ring_comes_back_to_its_start_without_a_false_closure():
     assert ate(r.poses, log.truth).rmse <= 0.2  # measured 0.107 m (odometry 14 m)
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="offices: driving the corridor back the other way, the 180-degree laser sees what "
-    "the keyframes a few metres ahead saw on the way out; the loop candidates are the keyframes "
-    "standing near the robot, which looked the other way: 1 closure on the way back. Candidates "
-    "chosen by where the keyframes looked close it (21 closures, 3.78 -> 2.64 cm) but cost MIT "
-    "CSAIL 25 % of its speed (117x -> 88x real time), under issue 11's 100x: not adopted yet",
-)
 def test_a_corridor_driven_back_the_other_way_is_closed():
-    """The ``offices`` route drives its corridor east, then back west (see the reason)."""
+    """The ``offices`` route drives its corridor east, then back west: the 180-degree laser
+    sees what the keyframes a few metres *ahead* saw on the way out. Loop candidates chosen
+    by where the keyframes stood (they looked the other way) closed once on the way back
+    (ATE 3.78 cm); chosen by where they looked, 22 times."""
     from fhslam.geometry import relative
 
     log = simulate(load_world("offices"), seed=0)
     slam = GraphFastHoughSLAM()
-    run_backend(slam, log)
+    r = run_backend(slam, log)
     steps = slam.keyframe_steps
     back = np.flatnonzero(log.truth[:, 0] > 18.9)[-1]  # the U-turn at the corridor's east end
     for lc in slam.accepted_loops:
         true = relative(log.truth[steps[lc.old]], log.truth[steps[lc.new]])
-        assert np.hypot(*(lc.pose[:2] - true[:2])) <= 0.3, (lc.old, lc.new)  # measured <= 0.03
-    assert sum(steps[lc.new] > back for lc in slam.accepted_loops) >= 10  # measured 1
+        assert np.hypot(*(lc.pose[:2] - true[:2])) <= 0.3, (lc.old, lc.new)  # measured <= 0.09
+    assert sum(steps[lc.new] > back for lc in slam.accepted_loops) >= 10  # measured 22
+    assert ate(r.poses, log.truth).rmse <= 0.03  # measured 2.28 cm (odometry 81 cm)
 
 
 def test_a_candidate_that_failed_for_the_previous_keyframe_waits_a_keyframe(
@@ -279,6 +275,29 @@ def test_dropped_scans_and_clutter(three_laps):
     assert ate(r.poses, log.truth).rmse <= 0.10  # measured 1.5 cm
 
 
+def test_a_keyframe_that_saw_nothing_looks_where_it_stands(three_laps):
+    """Scans 300-339 dropped (a blind stretch of 2.4 m): the keyframes started there have
+    no points, and where they looked (for the loop search) is their own position; no empty
+    mean, no NaN, and the run closes its loops as before."""
+    import dataclasses
+    import warnings
+
+    ranges = three_laps.ranges.copy()
+    ranges[300:340] = np.nan
+    log = dataclasses.replace(three_laps, ranges=ranges)
+    slam = GraphFastHoughSLAM()
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", RuntimeWarning)  # numpy's "Mean of empty slice"
+        r = run_backend(slam, log)
+    steps = slam.keyframe_steps
+    blind = np.flatnonzero((steps > 300) & (steps < 339))
+    assert len(blind) >= 3  # measured 6
+    np.testing.assert_array_equal(slam._views[blind], 0.0)
+    assert np.isfinite(slam._views).all() and len(slam._views) == len(slam.graph)
+    assert len(slam.loops) >= 20  # measured 97
+    assert ate(r.poses, log.truth).rmse <= 0.05  # measured 0.97 cm
+
+
 def test_without_loop_closures_no_loop_edges(three_laps):
     slam = GraphFastHoughSLAM(GraphSlamParams(loop_candidates=0))
     run_backend(slam, three_laps)
@@ -354,11 +373,11 @@ def _relations_error(real_data, name, odometry_noise_seed=None, drop_fraction=0.
 # machine). The assertion is the limit: the measured values leave room for last-bit
 # differences between CPUs. README: the table and the commands.
 REAL_LOGS = {
-    "intel": (0.05, 0.0140),
-    "aces": (0.06, 0.0348),
-    "mit-csail": (0.06, 0.0281),
-    "fr079": (0.08, 0.0301),
-    "fr-clinic": (0.15, 1.18),
+    "intel": (0.05, 0.0143),
+    "aces": (0.06, 0.0346),
+    "mit-csail": (0.06, 0.0266),
+    "fr079": (0.08, 0.0303),
+    "fr-clinic": (0.15, 1.13),
 }
 
 
@@ -398,18 +417,18 @@ def test_the_hospitals_relations_under_a_minute_hold(real_data):
 def test_mit_csail_does_not_turn_on_the_last_bit(real_data, seed):
     """The odometry multiplied by (1 + 1e-15 ε): before closures that move a keyframe far
     waited for an independent one, seed 2 gave 0.394 m instead of 0.043 m; measured now
-    0.0269, 0.0281 and 0.0281 m for seeds 1, 2 and unperturbed."""
+    0.0268, 0.0269 and 0.0266 m for seeds 1, 2 and unperturbed."""
     e = _relations_error(real_data, "mit-csail", odometry_noise_seed=seed)
     assert e.trans_mean <= 0.035, f"seed {seed}: {e.trans_mean:.4f} m"
 
 
-@pytest.mark.parametrize(("name", "every_scan"), [("mit-csail", 0.0281), ("fr079", 0.0301)])
+@pytest.mark.parametrize(("name", "every_scan"), [("mit-csail", 0.0266), ("fr079", 0.0303)])
 def test_dropped_scans_change_little(real_data, name, every_scan):
     """10 % of the scans dropped (issue 10: no log's error may change by more than 25 % or
     1 cm). MIT CSAIL: a 5 Hz laser then turns up to 50 degrees between two scans, into space
     the local map has not seen; before the tracker matched such a scan against the previous
     one, five doubtful scans followed the odometry and forced a keyframe 14-17 degrees off:
-    0.73 m (measured now 0.0284 m). Freiburg 079: with the bag's laser mount (+0.04 m) the
+    0.73 m (measured now 0.0278 m). Freiburg 079: with the bag's laser mount (+0.04 m) the
     result swung between 0.064 m and 0.040 m (measured now 0.0308 m)."""
     e = _relations_error(real_data, name, drop_fraction=0.1)
     assert e.n_used < e.n_total  # relations at dropped scans cannot be evaluated
@@ -422,6 +441,6 @@ def test_aces_revisit_is_closed_whatever_the_last_bit(real_data, seed):
     """ACES's revisit (scans 158-172 against 4194-4422): with a Cauchy scale of 1 the
     closures there lost most of their pull and the two visits stayed 1.1-1.3 m apart unless
     the last bit happened to help (0.0465 m unperturbed, 0.0345 m with seed 1); measured
-    now 0.0348 m unperturbed and 0.0346 m with seed 1."""
+    now 0.0346 m unperturbed and with seed 1."""
     e = _relations_error(real_data, "aces", odometry_noise_seed=seed)
     assert e.trans_mean <= 0.040, f"seed {seed}: {e.trans_mean:.4f} m"

@@ -113,7 +113,8 @@ def test_a_corridor_driven_back_the_other_way_is_closed():
         true = relative(log.truth[steps[lc.old]], log.truth[steps[lc.new]])
         assert np.hypot(*(lc.pose[:2] - true[:2])) <= 0.3, (lc.old, lc.new)  # measured <= 0.09
     assert sum(steps[lc.new] > back for lc in slam.accepted_loops) >= 10  # measured 22
-    assert ate(r.poses, log.truth).rmse <= 0.03  # measured 2.28 cm (odometry 81 cm)
+    # issue 10's limit; measured 2.28 cm (odometry 81 cm), 1.6-2.5 cm over 7 last-bit draws
+    assert ate(r.poses, log.truth).rmse <= 0.03
 
 
 def test_a_candidate_that_failed_for_the_previous_keyframe_waits_a_keyframe(

@@ -453,7 +453,7 @@ class GraphFastHoughSLAM:
         self._normals: list[NDArray[np.float64]] = []  # each cloud point's normal or NaN
         self._chunks: list[list[tuple[NDArray, NDArray]]] = []  # scans not yet thinned in
         self._kf_lines: list[list[Line]] = []
-        self._views = np.zeros((0, 2))  # each complete keyframe's cloud mean (its frame)
+        self._views = np.zeros((0, 3))  # each complete keyframe's cloud mean (its frame), θ 0
         self._path: list[float] = []  # distance travelled at each keyframe
         self._last_loop_path = 0.0
         self._doubtful = 0  # doubtful scans in a row
@@ -576,7 +576,7 @@ class GraphFastHoughSLAM:
         """Keyframe ``m`` is complete: thin its cloud and note where it looked (the cloud's
         mean, its frame; its origin if it saw nothing)."""
         cloud = self._cloud(m)[0]
-        view = cloud.mean(axis=0) if len(cloud) else np.zeros(2)
+        view = [*cloud.mean(axis=0), 0.0] if len(cloud) else np.zeros(3)
         self._views = np.vstack([self._views, view])  # a new array: the back end reads it
 
     # -- keyframes and edges ---------------------------------------------------------------
@@ -674,12 +674,8 @@ class GraphFastHoughSLAM:
         radius = min(p.loop_max_radius, p.loop_radius + drift)
         # Candidates: the keyframes that looked where this one's query looks (keyframes
         # i-2..i); where a keyframe looked is its cloud's mean, placed at its pose.
-        v = self._views[: i + 1]
-        c, s = np.cos(poses[: i + 1, 2]), np.sin(poses[: i + 1, 2])
-        vx = poses[: i + 1, 0] + c * v[:, 0] - s * v[:, 1]
-        vy = poses[: i + 1, 1] + s * v[:, 0] + c * v[:, 1]
-        lo = max(0, i - 2)
-        d = np.hypot(vx[:n_old] - vx[lo:].mean(), vy[:n_old] - vy[lo:].mean())
+        views = compose(poses[: i + 1], self._views[: i + 1])[:, :2]
+        d = np.hypot(*(views[:n_old] - views[max(0, i - 2) :].mean(axis=0)).T)
         cands = [
             int(j) for j in np.argsort(d, kind="stable")[: p.loop_candidates] if d[j] <= radius
         ]

@@ -448,10 +448,13 @@ def _bound(pyr, level, pad, ix, iy, sx, sy):  # pragma: no cover
 
 
 @njit(cache=True, nogil=True)
-def _search_bnb(pyr, ox, oy, res, px, py, x0, y0, th0, n_t, n_a, da, w_t, w_r):  # pragma: no cover
+def _search_bnb(
+    pyr, ox, oy, res, px, py, x0, y0, th0, n_t, n_a, da, w_t, w_r, ex, ey, er
+):  # pragma: no cover
     """:func:`_search` by branch and bound over the max-pooled grids ``pyr``
     (:attr:`LikelihoodGrid.pyramid`): the same optimum, ties broken the same way (the first
-    of equal scores in the order angle, x shift, y shift)."""
+    of equal scores in the order angle, x shift, y shift). With ``er >= 0`` the shifts within
+    ``er`` of ``(ex, ey)`` in x and in y (every angle) are left out: the best pose elsewhere."""
     n = px.shape[0]
     pad = 1 << BNB_LEVELS
     na = 2 * n_a + 1
@@ -506,6 +509,8 @@ def _search_bnb(pyr, ox, oy, res, px, py, x0, y0, th0, n_t, n_a, da, w_t, w_r): 
         if bnd < best:
             continue
         if lv == 0:
+            if er >= 0 and abs(sx - ex) <= er and abs(sy - ey) <= er:
+                continue
             acc = _bound(pyr, 0, pad, ixs[a], iys[a], sx, sy)
             sc = acc / nn - w_t * res * np.sqrt(sx * sx + sy * sy) - w_r * abs((a - n_a) * da)
             if sc > best or (sc == best and (a, sx, sy) < (ba, bx_, by_)):
@@ -554,6 +559,7 @@ def correlative_search(
     window_angle: float,
     angle_step: float,
     prior: tuple[float, float] = (0.0, 0.0),
+    exclude: tuple[ArrayLike, float] | None = None,
 ) -> tuple[float, NDArray[np.float64]]:
     """Best ``(score, pose)`` over ``guess ± window`` (in steps of the grid's resolution)
     and ``± window_angle`` (in steps of ``angle_step``, radians).
@@ -561,18 +567,29 @@ def correlative_search(
     The search maximises the score minus ``prior[0]`` per metre and ``prior[1]`` per
     radian of distance from the guess; the score returned is the plain one. Windows of
     ``BNB_MIN_SHIFTS`` shifts or more are searched by branch and bound, smaller ones
-    exhaustively: the same optimum either way, bit for bit."""
+    exhaustively: the same optimum either way, bit for bit.
+
+    ``exclude=(pose, radius)`` leaves out the positions within ``radius`` metres of
+    ``pose`` in x and in y (at every heading): the best pose elsewhere, e.g. to tell
+    whether a match is unique (searched by branch and bound whatever the window)."""
     n_t = round(window / grid.resolution)
     n_a = int(np.ceil(window_angle / angle_step - 1e-9))
-    if n_t >= BNB_MIN_SHIFTS:
-        kernel, table = _search_bnb, (grid.pyramid,)
+    ex = ey = 0
+    er = -1
+    if exclude is not None:
+        centre = as_pose(exclude[0], "excluded pose")
+        ex = round((centre[0] - guess[0]) / grid.resolution)
+        ey = round((centre[1] - guess[1]) / grid.resolution)
+        er = round(float(exclude[1]) / grid.resolution)
+    if n_t >= BNB_MIN_SHIFTS or exclude is not None:
+        kernel, table, extra = _search_bnb, (grid.pyramid,), (ex, ey, er)
     else:
-        kernel, table = _search_padded, (grid.padded, GRID_PAD)
+        kernel, table, extra = _search_padded, (grid.padded, GRID_PAD), ()
     s, x, y, t = kernel(
         *table, float(grid.origin[0]), float(grid.origin[1]), grid.resolution,
         np.ascontiguousarray(points[:, 0]), np.ascontiguousarray(points[:, 1]),
         float(guess[0]), float(guess[1]), float(guess[2]), n_t, n_a, float(angle_step),
-        float(prior[0]), float(prior[1]),
+        float(prior[0]), float(prior[1]), *extra,
     )  # fmt: skip
     return float(s), np.array([x, y, t])
 
@@ -588,6 +605,9 @@ class MatchResult:
     coarse_score: float
     guess_score: float = 0.0
     """The coarse grid's score at the guess (0 without a coarse stage)."""
+    runner_up: float = 0.0
+    """The best coarse score more than ``exclude`` metres from the coarse optimum (0 unless
+    :func:`match_clouds` was asked for it)."""
 
 
 def _thin(points, n):
@@ -632,6 +652,7 @@ def match_clouds(
     fine: tuple[float, float, float] = (0.02, 0.04, 0.1),
     max_points: tuple[int, int] = (200, 500),
     prior: tuple[float, float] = (0.05, 0.05),
+    exclude: float = 0.0,
 ) -> MatchResult:
     """The pose of the ``query`` cloud's frame in the ``target`` cloud's frame.
 
@@ -657,6 +678,10 @@ def match_clouds(
         Score given up per metre and per radian of distance from the guess (coarse stage)
         and from the coarse optimum (fine stage): where the clouds cannot tell positions
         apart (along a corridor), the guess wins instead of the window's corner.
+    exclude : float
+        If > 0, also find the best coarse score more than this many metres (in x or y) from
+        the coarse optimum (:attr:`MatchResult.runner_up`): a match is unique only if
+        nothing elsewhere scores nearly as well (a corridor with doors every few metres).
 
     Returns
     -------
@@ -670,7 +695,7 @@ def match_clouds(
     (rc, sc, ac), (rf, sf, af) = coarse, fine
     if len(q) < 10:
         return MatchResult(g, 0.0, 0.0)
-    s_c = s_g = 0.0
+    s_c = s_g = s_r = 0.0
     if window > 0:
         near = _crop(tg, q, g, window + 3 * sc)
         if len(near) < 10:
@@ -678,25 +703,21 @@ def match_clouds(
         grid = LikelihoodGrid.build(near, rc, sc, window + 3 * sc)
         qc = _thin(voxel_downsample(q, rc), max_points[0])
         s_g = grid.score(qc, g)
-        s_c, g = correlative_search(
-            grid,
-            qc,
-            g,
-            window,
-            np.radians(window_deg),
-            np.radians(ac),
-            prior,
-        )
+        search = (window, np.radians(window_deg), np.radians(ac), prior)
+        s_c, best = correlative_search(grid, qc, g, *search)
+        if exclude > 0:
+            s_r = correlative_search(grid, qc, g, *search, exclude=(best, exclude))[0]
+        g = best
     qf = _thin(voxel_downsample(q, 1.5 * rf), max_points[1])
     fw = 6 * rf
     near = _crop(tg, q, g, fw + 3 * sf)
     if len(near) < 10:
-        return MatchResult(g, 0.0, s_c, s_g)
+        return MatchResult(g, 0.0, s_c, s_g, s_r)
     grid = LikelihoodGrid.build(near, rf, sf, fw + 3 * sf)
     s_f, pose = correlative_search(
         grid, qf, g, fw, np.radians(ac if window > 0 else window_deg), np.radians(af), prior
     )
-    return MatchResult(pose, s_f, s_c, s_g)
+    return MatchResult(pose, s_f, s_c, s_g, s_r)
 
 
 def densify(

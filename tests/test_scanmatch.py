@@ -261,4 +261,57 @@ def test_branch_and_bound_finds_exactly_the_exhaustive_optimum(prior):
         guess = rng.normal(0, [0.2, 0.2, 0.05])
         qx, qy = np.ascontiguousarray(query.T)
         args = (*grid.origin, res, qx, qy, *guess, n_t, n_a, np.radians(0.7), *prior)
-        assert _search_bnb(grid.pyramid, *args) == _search(grid.values, *args)
+        assert _search_bnb(grid.pyramid, *args, 0, 0, -1) == _search(grid.values, *args)
+
+
+@pytest.mark.parametrize("n_t", [3, 12])
+def test_a_search_can_leave_out_the_positions_near_a_pose(n_t):
+    """``exclude=(pose, radius)``: the best score over the shifts more than ``radius`` from
+    ``pose`` in x or in y, as an exhaustive count with the kernel's own cell arithmetic
+    finds it (branch and bound, also for a window under ``BNB_MIN_SHIFTS`` shifts)."""
+    from fhslam.scanmatch import correlative_search
+
+    res = 0.05
+    grid = LikelihoodGrid.build(_room(), res, 0.08, n_t * res + 0.3)
+    query = transform_points([0.04, -0.03, 0.02], _room()[::4])
+    guess, window, wa, da = np.zeros(3), n_t * res, np.radians(2.0), np.radians(1.0)
+    best_score, best = correlative_search(grid, query, guess, window, wa, da)
+    score, pose = correlative_search(grid, query, guess, window, wa, da, exclude=(best, 2 * res))
+    ex, ey = np.round(best[:2] / res).astype(int)
+    h, w = grid.values.shape
+    expected = -np.inf
+    for ka in range(-2, 3):
+        c, s = np.cos(ka * da), np.sin(ka * da)
+        ix = np.floor((c * query[:, 0] - s * query[:, 1] - grid.origin[0]) / res).astype(int)
+        iy = np.floor((s * query[:, 0] + c * query[:, 1] - grid.origin[1]) / res).astype(int)
+        for sx, sy in itertools.product(range(-n_t, n_t + 1), repeat=2):
+            if abs(sx - ex) <= 2 and abs(sy - ey) <= 2:
+                continue
+            u, v = ix + sx, iy + sy
+            ok = (u >= 0) & (u < w) & (v >= 0) & (v < h)
+            expected = max(expected, grid.values[v[ok], u[ok]].astype(float).sum() / len(query))
+    assert score == pytest.approx(expected, rel=1e-9)
+    assert max(abs(pose[0] - best[0]), abs(pose[1] - best[1])) > 2 * res - 1e-9
+    assert score < best_score
+
+
+def test_a_match_in_a_repeating_corridor_has_a_runner_up_as_good():
+    """``match_clouds(..., exclude=r)`` reports the best coarse score more than ``r`` from
+    the coarse optimum: in a corridor with a pillar every 2 m a query seeing four pillars
+    matches one pillar further almost as well; in the room with its box, nothing else
+    comes close."""
+    x = np.arange(0.0, 20.0, 0.02)
+    walls = np.vstack([np.column_stack([x, np.full_like(x, y)]) for y in (0.0, 3.0)])
+    t = np.linspace(0, 2 * np.pi, 32, endpoint=False)
+    pillars = np.vstack(
+        [np.column_stack([cx + 0.2 * np.cos(t), 1.5 + 0.2 * np.sin(t)]) for cx in range(1, 20, 2)]
+    )
+    corridor = np.vstack([walls, pillars])
+    query = corridor[(corridor[:, 0] > 6.5) & (corridor[:, 0] < 13.5)]
+    m = match_clouds(corridor, query, [0.3, 0.1, 0.0], window=3.0, exclude=1.0)
+    assert m.runner_up >= 0.9 * m.coarse_score  # measured 1.0 and 1.0
+    room = _room()
+    m = match_clouds(room, room, [0.3, 0.1, 0.0], window=3.0, exclude=1.0)
+    assert np.hypot(*m.pose[:2]) <= 0.02
+    assert m.runner_up <= 0.8 * m.coarse_score  # measured 0.48 of 1.0
+    assert match_clouds(room, room, [0.3, 0.1, 0.0], window=3.0).runner_up == 0.0

@@ -213,9 +213,9 @@ class GraphSlamParams:
         with it (``loop_consistency``, ``loop_consistency_deg``); both then enter the graph.
         The Freiburg hospital comes back to its start after 900 m without a closure, its
         estimate 17-39 m and 12-25 degrees off: its global matches there score 0.64-0.68
-        (elsewhere in the log at most 0.45), and the relation error falls from 1.13 m to
-        0.126 m. On the other shared logs no stretch without a closure is longer than 85 m:
-        the search never runs.
+        (before it at most 0.31), and the relation error falls from 1.13 m to 0.126 m.
+        On the other shared logs no stretch without a closure is longer than 85 m: the
+        search never runs.
     global_keyframes : int
         See ``global_every``.
     global_min_score : float
@@ -807,18 +807,17 @@ class GraphFastHoughSLAM:
         h = self._hypothesis
         if h is not None and i - h[1] > p.global_keyframes + p.global_every:
             h = self._hypothesis = None  # not confirmed in time
-        due = (
-            i - self._last_global >= p.global_every if h is None else i - h[1] >= p.global_keyframes
-        )
-        if not due:
-            return
+        if h is None and i - self._last_global < p.global_every:
+            return False
+        if h is not None and i - h[1] < p.global_keyframes:
+            return False  # the next query must share no keyframe with the hypothesis's
         self._last_global = i
         g = self._global_match(i, poses)
         if g is None:
-            return
+            return False
         if h is None or not self._agree(h, g, poses):
             self._hypothesis = g
-            return
+            return False
         self._hypothesis = None
         closed = [self._add_loop(*x[:5]) for x in (h, g)]
         self._last_loop_path = self._path[i]

@@ -856,6 +856,8 @@ class GraphFastHoughSLAM:
         placed = compose(compose(poses[i], m.pose), relative(poses[i], [*looks, 0.0]))[:2]
         near = np.hypot(*(views[old] - placed).T)
         j = int(old[np.argmin(near)])
+        if near.min() > p.cloud_max_range:
+            return None  # placed where no old keyframe looked
         pts, nrm = self._submap(j, old[near <= p.cloud_max_range], poses)
         guess = relative(poses[j], compose(poses[i], m.pose))
         ref = refine(PointMap.build(pts, nrm), voxel_downsample(query, 0.05), guess)

@@ -449,12 +449,14 @@ def _bound(pyr, level, pad, ix, iy, sx, sy):  # pragma: no cover
 
 @njit(cache=True, nogil=True)
 def _search_bnb(
-    pyr, ox, oy, res, px, py, x0, y0, th0, n_t, n_a, da, w_t, w_r, ex, ey, er
+    pyr, ox, oy, res, px, py, x0, y0, th0, n_t, n_a, da, w_t, w_r, ex, ey, er, floor
 ):  # pragma: no cover
     """:func:`_search` by branch and bound over the max-pooled grids ``pyr``
     (:attr:`LikelihoodGrid.pyramid`): the same optimum, ties broken the same way (the first
     of equal scores in the order angle, x shift, y shift). With ``er >= 0`` the shifts within
-    ``er`` of ``(ex, ey)`` in x and in y (every angle) are left out: the best pose elsewhere."""
+    ``er`` of ``(ex, ey)`` in x and in y (every angle) are left out: the best pose elsewhere.
+    Only poses scoring (with the prior) above ``floor`` are looked for: if there is none,
+    the score is 0 and the pose the guess."""
     n = px.shape[0]
     pad = 1 << BNB_LEVELS
     na = 2 * n_a + 1
@@ -498,7 +500,7 @@ def _search_bnb(
         q = order[t]
         st_l[sp], st_a[sp], st_x[sp], st_y[sp], st_b[sp] = top, ca[q], cx[q], cy[q], cb[q]
         sp += 1
-    best, best_acc = -np.inf, 0.0
+    best, best_acc = floor, 0.0
     ba, bx_, by_ = 0, 0, 0
     cb4 = np.empty(4)
     cx4 = np.empty(4, np.int64)
@@ -560,6 +562,7 @@ def correlative_search(
     angle_step: float,
     prior: tuple[float, float] = (0.0, 0.0),
     exclude: tuple[ArrayLike, float] | None = None,
+    floor: float = -np.inf,
 ) -> tuple[float, NDArray[np.float64]]:
     """Best ``(score, pose)`` over ``guess ± window`` (in steps of the grid's resolution)
     and ``± window_angle`` (in steps of ``angle_step``, radians).
@@ -571,7 +574,9 @@ def correlative_search(
 
     ``exclude=(pose, radius)`` leaves out the positions within ``radius`` metres of
     ``pose`` in x and in y (at every heading): the best pose elsewhere, e.g. to tell
-    whether a match is unique (searched by branch and bound whatever the window)."""
+    whether a match is unique (searched by branch and bound whatever the window). With a
+    ``floor``, only poses whose score less the prior exceeds it are looked for (branch and
+    bound prunes the rest at once): if there is none, ``(0.0, guess)`` is returned."""
     n_t = round(window / grid.resolution)
     n_a = int(np.ceil(window_angle / angle_step - 1e-9))
     ex = ey = 0
@@ -581,8 +586,8 @@ def correlative_search(
         ex = round((centre[0] - guess[0]) / grid.resolution)
         ey = round((centre[1] - guess[1]) / grid.resolution)
         er = round(float(exclude[1]) / grid.resolution)
-    if n_t >= BNB_MIN_SHIFTS or exclude is not None:
-        kernel, table, extra = _search_bnb, (grid.pyramid,), (ex, ey, er)
+    if n_t >= BNB_MIN_SHIFTS or exclude is not None or floor > -np.inf:
+        kernel, table, extra = _search_bnb, (grid.pyramid,), (ex, ey, er, float(floor))
     else:
         kernel, table, extra = _search_padded, (grid.padded, GRID_PAD), ()
     s, x, y, t = kernel(
@@ -606,8 +611,9 @@ class MatchResult:
     guess_score: float = 0.0
     """The coarse grid's score at the guess (0 without a coarse stage)."""
     runner_up: float = 0.0
-    """The best coarse score more than ``exclude`` metres from the coarse optimum (0 unless
-    :func:`match_clouds` was asked for it)."""
+    """The best coarse score more than ``exclude[0]`` metres from the coarse optimum if it is
+    more than ``exclude[1]`` times the coarse score, else 0 (0 unless :func:`match_clouds`
+    was asked for it)."""
 
 
 def _thin(points, n):
@@ -652,7 +658,8 @@ def match_clouds(
     fine: tuple[float, float, float] = (0.02, 0.04, 0.1),
     max_points: tuple[int, int] = (200, 500),
     prior: tuple[float, float] = (0.05, 0.05),
-    exclude: float = 0.0,
+    exclude: tuple[float, float] | None = None,
+    min_coarse: float = -np.inf,
 ) -> MatchResult:
     """The pose of the ``query`` cloud's frame in the ``target`` cloud's frame.
 
@@ -678,10 +685,18 @@ def match_clouds(
         Score given up per metre and per radian of distance from the guess (coarse stage)
         and from the coarse optimum (fine stage): where the clouds cannot tell positions
         apart (along a corridor), the guess wins instead of the window's corner.
-    exclude : float
-        If > 0, also find the best coarse score more than this many metres (in x or y) from
-        the coarse optimum (:attr:`MatchResult.runner_up`): a match is unique only if
-        nothing elsewhere scores nearly as well (a corridor with doors every few metres).
+    exclude : (float, float), optional
+        ``(radius, fraction)``: also look for the best coarse score more than ``radius``
+        metres (in x or y) from the coarse optimum, above ``fraction`` of the coarse score
+        (:attr:`MatchResult.runner_up`): a match is unique only if nothing elsewhere scores
+        nearly as well (a corridor with doors every few metres). Branch and bound looks only
+        where that is possible, so an answer of "none" is cheap.
+    min_coarse : float
+        The coarse stage looks only for poses scoring (less the prior) above this: if there
+        is none, the result has scores 0 and the guess as its pose, and the fine stage does
+        not run. Cheap where most searches find nothing (a global search over a large
+        window); the coarse grid's wider likelihood scores a pose at least about as high as
+        the fine grid, so a floor at the fine score wanted loses nothing.
 
     Returns
     -------
@@ -704,9 +719,13 @@ def match_clouds(
         qc = _thin(voxel_downsample(q, rc), max_points[0])
         s_g = grid.score(qc, g)
         search = (window, np.radians(window_deg), np.radians(ac), prior)
-        s_c, best = correlative_search(grid, qc, g, *search)
-        if exclude > 0:
-            s_r = correlative_search(grid, qc, g, *search, exclude=(best, exclude))[0]
+        s_c, best = correlative_search(grid, qc, g, *search, floor=min_coarse)
+        if s_c == 0.0 and min_coarse > -np.inf:
+            return MatchResult(g, 0.0, 0.0, s_g)  # nothing above the floor
+        if exclude is not None:
+            s_r = correlative_search(
+                grid, qc, g, *search, exclude=(best, exclude[0]), floor=exclude[1] * s_c
+            )[0]
         g = best
     qf = _thin(voxel_downsample(q, 1.5 * rf), max_points[1])
     fw = 6 * rf

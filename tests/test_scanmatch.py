@@ -261,7 +261,7 @@ def test_branch_and_bound_finds_exactly_the_exhaustive_optimum(prior):
         guess = rng.normal(0, [0.2, 0.2, 0.05])
         qx, qy = np.ascontiguousarray(query.T)
         args = (*grid.origin, res, qx, qy, *guess, n_t, n_a, np.radians(0.7), *prior)
-        assert _search_bnb(grid.pyramid, *args, 0, 0, -1) == _search(grid.values, *args)
+        assert _search_bnb(grid.pyramid, *args, 0, 0, -1, -np.inf) == _search(grid.values, *args)
 
 
 @pytest.mark.parametrize("n_t", [3, 12])
@@ -296,10 +296,10 @@ def test_a_search_can_leave_out_the_positions_near_a_pose(n_t):
 
 
 def test_a_match_in_a_repeating_corridor_has_a_runner_up_as_good():
-    """``match_clouds(..., exclude=r)`` reports the best coarse score more than ``r`` from
-    the coarse optimum: in a corridor with a pillar every 2 m a query seeing four pillars
-    matches one pillar further almost as well; in the room with its box, nothing else
-    comes close."""
+    """``match_clouds(..., exclude=(r, f))`` reports the best coarse score more than ``r``
+    from the coarse optimum if it is above ``f`` of the coarse score: in a corridor with a
+    pillar every 2 m a query seeing four pillars matches one pillar further as well; in the
+    room with its box, nothing else comes close."""
     x = np.arange(0.0, 20.0, 0.02)
     walls = np.vstack([np.column_stack([x, np.full_like(x, y)]) for y in (0.0, 3.0)])
     t = np.linspace(0, 2 * np.pi, 32, endpoint=False)
@@ -308,10 +308,40 @@ def test_a_match_in_a_repeating_corridor_has_a_runner_up_as_good():
     )
     corridor = np.vstack([walls, pillars])
     query = corridor[(corridor[:, 0] > 6.5) & (corridor[:, 0] < 13.5)]
-    m = match_clouds(corridor, query, [0.3, 0.1, 0.0], window=3.0, exclude=1.0)
+    m = match_clouds(corridor, query, [0.3, 0.1, 0.0], window=3.0, exclude=(1.0, 0.9))
     assert m.runner_up >= 0.9 * m.coarse_score  # measured 1.0 and 1.0
     room = _room()
-    m = match_clouds(room, room, [0.3, 0.1, 0.0], window=3.0, exclude=1.0)
+    m = match_clouds(room, room, [0.3, 0.1, 0.0], window=3.0, exclude=(1.0, 0.3))
     assert np.hypot(*m.pose[:2]) <= 0.02
-    assert m.runner_up <= 0.8 * m.coarse_score  # measured 0.48 of 1.0
+    assert 0.3 * m.coarse_score < m.runner_up <= 0.6 * m.coarse_score  # measured 0.48 of 1.0
+    m = match_clouds(room, room, [0.3, 0.1, 0.0], window=3.0, exclude=(1.0, 0.8))
+    assert m.runner_up == 0.0  # none above 0.8 of the best
     assert match_clouds(room, room, [0.3, 0.1, 0.0], window=3.0).runner_up == 0.0
+
+
+def test_a_search_with_a_floor_looks_only_above_it():
+    """``floor``: the same optimum when it lies above the floor, ``(0, guess)`` when
+    nothing does."""
+    from fhslam.scanmatch import correlative_search
+
+    grid = LikelihoodGrid.build(_room(), 0.05, 0.08, 1.0)
+    query = transform_points([0.04, -0.03, 0.02], _room()[::4])
+    args = (grid, query, np.zeros(3), 0.6, np.radians(3.0), np.radians(1.0))
+    score, pose = correlative_search(*args)
+    low, at = correlative_search(*args, floor=score - 0.05)
+    assert low == score and np.array_equal(at, pose)
+    assert correlative_search(*args, floor=score)[0] == 0.0  # nothing strictly above
+
+
+def test_a_match_with_a_coarse_floor_stops_early_or_not_at_all():
+    """``min_coarse``: the same match when the coarse optimum lies above the floor; scores
+    0 and the guess when nothing does (the fine stage is skipped)."""
+    room = _room()
+    query = transform_points([0.2, -0.1, 0.05], room)
+    guess = [0.1, 0.1, 0.0]
+    plain = match_clouds(room, query, guess, window=1.0)
+    floored = match_clouds(room, query, guess, window=1.0, min_coarse=0.5)
+    assert np.array_equal(floored.pose, plain.pose)
+    assert (floored.score, floored.coarse_score) == (plain.score, plain.coarse_score)
+    none = match_clouds(room, query, guess, window=1.0, min_coarse=1.0)
+    assert none.score == none.coarse_score == 0.0 and np.array_equal(none.pose, guess)

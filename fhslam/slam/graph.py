@@ -847,10 +847,10 @@ class GraphFastHoughSLAM:
             return None
         m = match_clouds(
             target, query, np.zeros(3), win, p.global_window_deg, prior=(0.0, 0.0),
-            exclude=p.loop_window,
+            exclude=(p.loop_window, p.global_max_ambiguity), min_coarse=p.global_min_score,
         )  # fmt: skip
-        if m.score < p.global_min_score or m.runner_up > p.global_max_ambiguity * m.coarse_score:
-            return None
+        if m.score < p.global_min_score or m.runner_up > 0:
+            return None  # too low, or not unique
         # The closure's old keyframe: the one that looked nearest where the query looks, at
         # the match; refined against the old keyframes around it, in its frame.
         placed = compose(compose(poses[i], m.pose), relative(poses[i], [*looks, 0.0]))[:2]

@@ -736,7 +736,7 @@ class GraphFastHoughSLAM:
             return  # closed: the local search goes on from the next keyframe
         # Candidates: the keyframes that looked where this one's query looks (keyframes
         # i-2..i); where a keyframe looked is its cloud's mean, placed at its pose.
-        views = compose(poses[: i + 1], self._views[: i + 1])[:, :2]
+        views = self._looks(poses, i)
         d = np.hypot(*(views[:n_old] - views[max(0, i - 2) :].mean(axis=0)).T)
         cands = [
             int(j) for j in np.argsort(d, kind="stable")[: p.loop_candidates] if d[j] <= radius
@@ -767,19 +767,17 @@ class GraphFastHoughSLAM:
                 self._failed[j] = i
                 continue
             ref = refine(self.loop_targets.point_map(cached), q_refine, m.pose)
-            if ref.n_matched < p.loop_min_pairs or ref.rms > p.loop_max_rms:
+            c = self._verified(j, i, ref, m.pose, m.score, poses)
+            if c is None:
                 continue
-            z = ref.pose if np.hypot(*(ref.pose[:2] - m.pose[:2])) <= 0.05 else m.pose
-            info = self._information(ref, float(z[2]))
-            implied = compose(poses[j], z)  # where the closure puts keyframe i
-            move = implied - poses[i]
+            move = c[5] - poses[i]  # how far the closure moves keyframe i
             if not tracking and (
                 np.hypot(move[0], move[1]) > p.loop_confirm_distance
                 or abs(np.degrees(np.angle(np.exp(1j * move[2])))) > p.loop_confirm_deg
             ):
-                held.append((j, i, z, info, m.score, implied))
+                held.append(c)
                 continue
-            closed.append(self._add_loop(j, i, z, info, m.score))
+            closed.append(self._add_loop(*c[:5]))
         if closed:
             self._pending = []  # the estimate is confirmed as it stands
         self._pending = [h for h in self._pending if i - h[1] <= p.loop_confirm_window]
@@ -798,6 +796,10 @@ class GraphFastHoughSLAM:
             self._last_loop_path = self._path[i]
             if self._graph.chi2(np.array(closed)).max() >= p.loop_optimize_chi2:
                 self._optimize()
+
+    def _looks(self, poses, i: int) -> NDArray[np.float64]:
+        """Where keyframes ``0 .. i`` looked: their clouds' means placed at ``poses``."""
+        return compose(poses[: i + 1], self._views[: i + 1])[:, :2]
 
     def _search_globally(self, i: int, poses) -> bool:
         """The global search (see ``global_every``): a match is held as a hypothesis until a
@@ -836,7 +838,7 @@ class GraphFastHoughSLAM:
         old = np.flatnonzero(path <= path[i] - reach)
         travelled = path[i] - self._last_loop_path
         win = min(p.global_max_window, max(p.loop_max_window, p.loop_growth * travelled))
-        views = compose(poses[: i + 1], self._views[: i + 1])[:, :2]
+        views = self._looks(poses, i)
         looks = views[max(0, i - 2) :].mean(axis=0)
         old = old[np.hypot(*(views[old] - looks).T) <= win + p.cloud_max_range]
         if not len(old):
@@ -861,10 +863,18 @@ class GraphFastHoughSLAM:
         pts, nrm = self._submap(j, old[near <= p.cloud_max_range], poses)
         guess = relative(poses[j], compose(poses[i], m.pose))
         ref = refine(PointMap.build(pts, nrm), voxel_downsample(query, 0.05), guess)
+        return self._verified(j, i, ref, guess, m.score, poses)
+
+    def _verified(self, j: int, i: int, ref: Refinement, matched, score: float, poses):
+        """The closure ``(j, i, z, information, score, where it puts keyframe i)`` from a
+        match of keyframe ``i``'s query against ``j``'s target at ``matched``, refined to
+        ``ref``; None if the refinement pairs too few points or too loosely. The refined
+        pose is taken unless it wandered more than 5 cm from the match."""
+        p = self.params
         if ref.n_matched < p.loop_min_pairs or ref.rms > p.loop_max_rms:
             return None
-        z = ref.pose if np.hypot(*(ref.pose[:2] - guess[:2])) <= 0.05 else guess
-        return j, i, z, self._information(ref, float(z[2])), m.score, compose(poses[j], z)
+        z = ref.pose if np.hypot(*(ref.pose[:2] - matched[:2])) <= 0.05 else matched
+        return j, i, z, self._information(ref, float(z[2])), score, compose(poses[j], z)
 
     def _add_loop(self, j: int, i: int, z, info, score: float) -> int:
         e = self._graph.add_edge(j, i, z, info, self.params.loop_kernel, kind="loop")

@@ -328,6 +328,9 @@ def _slam(args: argparse.Namespace) -> None:
     )
     with _profiling(args.profile):
         log = _load(args)
+        log, degraded = _degraded(log, args)
+        if degraded:
+            print(f"{args.log}: {degraded}")
         if len(log) == 1:
             warnings.warn(
                 f"{args.log}: a single scan: nothing to match it with; the trajectory is its "
@@ -350,7 +353,9 @@ def _slam(args: argparse.Namespace) -> None:
                 args.trajectory,
                 result.timestamps,
                 result.poses,
-                header=f"fhslam slam --method {args.method} {args.log}: timestamp x y theta",
+                header=f"fhslam slam --method {args.method} {args.log}"
+                + (f" ({degraded})" if degraded else "")
+                + ": timestamp x y theta",
             )
             wrote = [f"{len(result.poses)} poses to {args.trajectory}"]
             if args.map is not None:
@@ -366,6 +371,33 @@ def _slam(args: argparse.Namespace) -> None:
                 _write_plot(args.plot, log, result, args.method, graph)
                 wrote.append(f"a picture of the run to {args.plot}")
         print("wrote " + ", ".join(wrote[:-1]) + (" and " if len(wrote) > 1 else "") + wrote[-1])
+
+
+def _degraded(log, args: argparse.Namespace):
+    """The log as ``slam``'s robustness options make it, and what they did (``""``: none)."""
+    from fhslam.sim import degrade, perturb_odometry
+
+    done = []
+    if args.range_noise or args.drop_scans or args.clutter:
+        n = len(log)
+        log = degrade(
+            log,
+            drop_fraction=args.drop_scans,
+            clutter_fraction=args.clutter,
+            seed=args.degrade_seed,
+            range_noise=args.range_noise,
+        )
+        if args.range_noise:
+            done.append(f"{1000 * args.range_noise:g} mm of range noise")
+        if args.drop_scans:
+            done.append(f"{n - len(log)} of {n} scans dropped")
+        if args.clutter:
+            done.append(f"{100 * args.clutter:g} % clutter")
+        done[-1] += f" (seed {args.degrade_seed})"
+    if args.last_bit is not None:
+        log = perturb_odometry(log, args.last_bit)
+        done.append(f"odometry x (1 + 1e-15 e), seed {args.last_bit}")
+    return log, ", ".join(done)
 
 
 def _write_plot(path: Path, log, result, method: str, graph) -> None:
@@ -466,6 +498,34 @@ def _non_negative_seconds(text: str) -> float:
     return value
 
 
+def _non_negative(unit: str):
+    """An argparse type: a finite number of ``unit``, 0 or more."""
+
+    def parse(text: str) -> float:
+        try:
+            value = float(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"not a number: {text!r}") from None
+        if not (value >= 0 and value < float("inf")):
+            raise argparse.ArgumentTypeError(f"must be a finite number of {unit} >= 0, got {text}")
+        return value
+
+    return parse
+
+
+def _fraction(text: str) -> float:
+    """An argparse type: a share in [0, 1)."""
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"not a number: {text!r}") from None
+    if not 0 <= value < 1:
+        raise argparse.ArgumentTypeError(
+            f"must be a share from 0 up to (not including) 1, got {text}"
+        )
+    return value
+
+
 def _positive_int(text: str) -> int:
     """An argparse type: a whole number 1 or more."""
     try:
@@ -562,6 +622,46 @@ def build_parser() -> argparse.ArgumentParser:
     )
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.add_argument("--profile", action="store_true", help=PROFILE_HELP)
+    g = p.add_argument_group(
+        "robustness checks",
+        "degrade the log before the run (fhslam.sim.degrade, fhslam.sim.perturb_odometry); "
+        "the trajectory's header names what was done",
+    )
+    g.add_argument(
+        "--range-noise",
+        type=_non_negative("metres"),
+        default=0.0,
+        metavar="M",
+        help="Gaussian noise of M metres (standard deviation) on every valid range",
+    )
+    g.add_argument(
+        "--drop-scans",
+        type=_fraction,
+        default=0.0,
+        metavar="F",
+        help="drop this share of the scans (never the first), as lost laser messages",
+    )
+    g.add_argument(
+        "--clutter",
+        type=_fraction,
+        default=0.0,
+        metavar="F",
+        help="this share of each scan's valid beams returns short, as from people or chairs",
+    )
+    g.add_argument(
+        "--degrade-seed",
+        type=int,
+        default=0,
+        metavar="N",
+        help="seed of the noise, dropped scans and clutter (default 0)",
+    )
+    g.add_argument(
+        "--last-bit",
+        type=int,
+        metavar="SEED",
+        help="multiply the odometry by (1 + 1e-15 e), e standard normal drawn with SEED: what "
+        "the same code on another CPU does",
+    )
     p.set_defaults(run=_slam)
 
     p = sub.add_parser(

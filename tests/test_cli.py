@@ -876,3 +876,44 @@ def test_the_help_names_every_built_in_world():
     from fhslam.sim.world import BUILTIN_WORLDS
 
     assert ", ".join(f"'{w}'" for w in BUILTIN_WORLDS) == WORLDS_HELP
+
+
+def test_slam_robustness_options_run_the_degraded_log(short_clf, tmp_path, capsys):
+    """``--range-noise``, ``--drop-scans``, ``--clutter`` and ``--last-bit`` (issue 10's
+    robustness checks) run exactly ``fhslam.sim.degrade`` then ``perturb_odometry`` on the
+    log, say so, and record it in the trajectory's header."""
+    from fhslam.pipeline import run_slam
+    from fhslam.sim import degrade, perturb_odometry
+
+    out = tmp_path / "t.txt"
+    opts = ["--range-noise", "0.001", "--drop-scans", "0.1", "--clutter", "0.02"]
+    opts += ["--degrade-seed", "3", "--last-bit", "1"]
+    assert main(["slam", str(short_clf), "--trajectory", str(out), "--quiet", *opts]) == 0
+    said = capsys.readouterr().out
+    what = "1 mm of range noise, 6 of 60 scans dropped, 2 % clutter (seed 3), "
+    what += "odometry x (1 + 1e-15 e), seed 1"
+    assert f"{short_clf}: {what}" in said and "wrote 54 poses" in said
+    assert what in out.read_text().splitlines()[0]
+    log = degrade(read_carmen(short_clf), 0.1, 0.02, seed=3, range_noise=0.001)
+    expected = run_slam(perturb_odometry(log, 1))
+    t, poses = read_trajectory(out)
+    np.testing.assert_array_equal(t, expected.timestamps)
+    np.testing.assert_allclose(poses, expected.poses, atol=1e-9)  # the file's 9+ digits
+
+
+@pytest.mark.parametrize(
+    ("option", "value"),
+    [
+        ("--range-noise", "-0.001"),
+        ("--range-noise", "inf"),
+        ("--drop-scans", "1"),
+        ("--drop-scans", "-0.1"),
+        ("--clutter", "nan"),
+        ("--degrade-seed", "x"),
+        ("--last-bit", "1.5"),
+    ],
+)
+def test_slam_bad_robustness_option_is_a_usage_error(short_clf, tmp_path, option, value):
+    r = run("slam", str(short_clf), "--trajectory", str(tmp_path / "t.txt"), option, value)
+    assert r.returncode == 2 and option in r.stderr and "Traceback" not in r.stderr
+    assert not (tmp_path / "t.txt").exists()

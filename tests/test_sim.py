@@ -695,11 +695,73 @@ def test_degrade_works_without_truth_or_hits(paper_log):
         ({"clutter_fraction": float("nan")}, "clutter_fraction"),
         ({"clutter_fraction": "lots"}, "clutter_fraction"),
         ({"resolution": -0.001}, "resolution"),
+        ({"range_noise": -0.001}, "range_noise"),
+        ({"range_noise": float("inf")}, "range_noise"),
+        ({"range_noise": True}, "range_noise"),
+        ({"range_noise": "1 mm"}, "range_noise"),
     ],
 )
 def test_degrade_rejects_bad_arguments(paper_log, kwargs, match):
     with pytest.raises(ValueError, match=match):
         degrade(paper_log, **kwargs)
+
+
+def test_degrade_range_noise_on_valid_beams_only(paper_log):
+    """Issue 10's robustness check: Gaussian noise of 1 mm on every return, none on a
+    no-return, every return still one (inside (0, max_range))."""
+    out = degrade(paper_log, range_noise=0.001, seed=5)
+    valid = (paper_log.ranges > 0) & (paper_log.ranges < paper_log.max_range)
+    d = out.ranges - paper_log.ranges
+    assert valid.sum() > 10_000
+    assert abs(d[valid].mean()) < 3 * 0.001 / np.sqrt(valid.sum())  # unbiased
+    assert np.std(d[valid]) == pytest.approx(0.001, rel=0.03)
+    assert np.count_nonzero(d[valid]) == valid.sum()  # not rounded away to the 1 mm grid
+    np.testing.assert_array_equal(out.ranges[~valid], paper_log.ranges[~valid])
+    assert np.all(out.ranges[valid] > 0) and np.all(out.ranges[valid] < paper_log.max_range)
+    np.testing.assert_array_equal(out.hits, paper_log.hits)
+
+
+def test_degrade_range_noise_near_max_range_stays_a_return(paper_log):
+    from dataclasses import replace
+
+    ranges = np.where(paper_log.ranges < paper_log.max_range, paper_log.max_range - 1e-5, 8.0)
+    out = degrade(replace(paper_log, ranges=ranges), range_noise=0.01, seed=0)
+    hit = ranges < 8.0
+    assert np.all(out.ranges[hit] < 8.0) and np.all(out.ranges[~hit] == 8.0)
+
+
+def test_degrade_range_noise_changes_no_other_choice(paper_log):
+    """Noise draws from a stream of its own: the same scans dropped, the same clutter, with
+    and without it (and so the same as before range noise existed)."""
+    plain = degrade(paper_log, drop_fraction=0.1, clutter_fraction=0.05, seed=7)
+    noisy = degrade(paper_log, drop_fraction=0.1, clutter_fraction=0.05, seed=7, range_noise=0.002)
+    np.testing.assert_array_equal(noisy.timestamps, plain.timestamps)
+    np.testing.assert_array_equal(noisy.hits, plain.hits)
+    clutter = plain.hits == -1
+    np.testing.assert_array_equal(noisy.ranges[clutter], plain.ranges[clutter])  # not noisy
+    valid = plain.ranges < paper_log.max_range
+    assert np.count_nonzero(noisy.ranges[valid & ~clutter] != plain.ranges[valid & ~clutter]) > 0
+    again = degrade(paper_log, drop_fraction=0.1, clutter_fraction=0.05, seed=7, range_noise=0.002)
+    np.testing.assert_array_equal(again.ranges, noisy.ranges)
+
+
+def test_perturb_odometry_changes_the_last_bits_only(paper_log):
+    from fhslam.sim import perturb_odometry
+
+    out = perturb_odometry(paper_log, seed=1)
+    nz = paper_log.odometry != 0
+    rel = out.odometry[nz] / paper_log.odometry[nz] - 1
+    assert np.count_nonzero(rel) > 0.9 * nz.sum()
+    assert np.abs(rel).max() < 1e-14  # a few units in the last place
+    np.testing.assert_array_equal(perturb_odometry(paper_log, seed=1).odometry, out.odometry)
+    assert not np.array_equal(perturb_odometry(paper_log, seed=2).odometry, out.odometry)
+    np.testing.assert_array_equal(out.ranges, paper_log.ranges)
+    np.testing.assert_array_equal(out.truth, paper_log.truth)
+    bigger = perturb_odometry(paper_log, seed=1, relative=1e-3)
+    assert np.abs(bigger.odometry[nz] / paper_log.odometry[nz] - 1).max() > 1e-4
+    for bad in (-1e-15, float("nan"), "tiny"):
+        with pytest.raises(ValueError, match="relative"):
+            perturb_odometry(paper_log, seed=1, relative=bad)
 
 
 # ------------------------------------------------------------------- how long a route is

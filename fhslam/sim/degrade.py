@@ -1,7 +1,10 @@
-"""Degrade a log as a harsher world would: lost laser messages and clutter returns.
+"""Degrade a log as a harsher world would: lost laser messages, clutter returns, range noise;
+and perturb its odometry in the last bit, as another CPU would.
 
-:func:`degrade` works on any :class:`~fhslam.io.log.Log`, simulated or read from a file; the
-ground truth and wall hits of a simulated log follow the kept scans.
+:func:`degrade` and :func:`perturb_odometry` work on any :class:`~fhslam.io.log.Log`,
+simulated or read from a file; the ground truth and wall hits of a simulated log follow the
+kept scans. They make issue 10's robustness checks (``fhslam slam LOG --range-noise 0.001``,
+``--drop-scans 0.1``, ``--last-bit 1``).
 """
 
 from __future__ import annotations
@@ -17,6 +20,19 @@ CLUTTER_MIN_RANGE = 0.3
 
 CLUTTER_MAX_FRACTION = 0.9
 """Farthest clutter return, as a fraction of the beam's own (wall) range."""
+
+
+def _check_non_negative(name: str, value: float, unit: str = "") -> float:
+    what = f"{name} must be a finite number{unit} >= 0, got {value!r}"
+    if isinstance(value, bool):
+        raise ValueError(what)
+    try:
+        f = float(value)
+    except (TypeError, ValueError):
+        raise ValueError(what) from None
+    if not (np.isfinite(f) and f >= 0):
+        raise ValueError(what)
+    return f
 
 
 def _check_fraction(name: str, value: float) -> float:
@@ -37,8 +53,9 @@ def degrade(
     clutter_fraction: float = 0.0,
     seed: int = 0,
     resolution: float = 0.001,
+    range_noise: float = 0.0,
 ) -> Log:
-    """A copy of ``log`` with scans lost and clutter returns added.
+    """A copy of ``log`` with scans lost, clutter returns added and noise on the ranges.
 
     1. **Dropped scans.** ``round(drop_fraction * (T - 1))`` scans (Python's ``round``),
        chosen at random but never the first, are removed entirely: their timestamp, ranges,
@@ -52,7 +69,12 @@ def degrade(
        scan with ``n`` valid beams is ``clutter_fraction * n`` rounded up or down at random
        (up with probability its fractional part), so the share over a log is unbiased.
 
-    The random choices are fixed by ``seed`` and independent of the two fractions: a larger
+    3. **Range noise.** Every valid range that is not clutter gets Gaussian noise of standard
+       deviation ``range_noise`` metres (not rounded), kept 1 µm inside ``(0, max_range)``:
+       a wall stays a return. Drawn for all scans before any are dropped.
+
+    The random choices are fixed by ``seed`` and independent of one another: the noise
+    changes no dropped scan or clutter beam, and a larger
     ``drop_fraction`` drops a superset of the scans a smaller one drops, a larger
     ``clutter_fraction`` clutters a superset of the beams, and a beam's clutter range does
     not depend on either fraction. Clutter is drawn for all scans before any are dropped.
@@ -69,7 +91,9 @@ def degrade(
         Seed of the random choices.
     resolution : float
         Clutter ranges are rounded to multiples of this, metres (the LMS200's 1 mm); 0 keeps
-        them unrounded. Ranges that are not clutter are copied unchanged.
+        them unrounded. Ranges that are neither clutter nor noisy are copied unchanged.
+    range_noise : float
+        Standard deviation of the noise on the ranges, metres, 0 or more (0: none).
 
     Returns
     -------
@@ -80,14 +104,17 @@ def degrade(
     Raises
     ------
     ValueError
-        If a fraction is outside [0, 1) or not a number, or ``resolution`` is negative.
+        If a fraction is outside [0, 1) or not a number, or ``resolution`` or
+        ``range_noise`` is negative or not a finite number.
     """
     drop = _check_fraction("drop_fraction", drop_fraction)
     clutter = _check_fraction("clutter_fraction", clutter_fraction)
     if not (np.isfinite(resolution) and resolution >= 0):
         raise ValueError(f"resolution must be >= 0, got {resolution!r}")
-    drop_rng, clutter_rng = (
-        np.random.default_rng(s) for s in np.random.SeedSequence(seed).spawn(2)
+    sigma = _check_non_negative("range_noise", range_noise, " of metres")
+    # Three independent streams; the first two are what they were before range noise.
+    drop_rng, clutter_rng, noise_rng = (
+        np.random.default_rng(s) for s in np.random.SeedSequence(seed).spawn(3)
     )
     t, b = log.ranges.shape
 
@@ -115,6 +142,13 @@ def degrade(
     if hits is not None:
         hits[is_clutter] = -1
 
+    # Range noise, on every valid beam that is not clutter, inside (0, max_range).
+    if sigma > 0:
+        noisy = valid & ~is_clutter
+        r = ranges[noisy] + noise_rng.normal(0.0, sigma, int(noisy.sum()))
+        # the simulator's margin without rounding (fhslam.sim.laser.add_range_noise)
+        ranges[noisy] = np.clip(r, 1e-6, log.max_range - 1e-6)
+
     # Dropped scans: a random order of scans 1..T-1, the first n of which are lost.
     n_drop = round(drop * max(t - 1, 0))
     order = drop_rng.permutation(np.arange(1, max(t, 1)))
@@ -132,3 +166,26 @@ def degrade(
         hits=None if hits is None else hits[keep],
         angle_offsets=None if log.angle_offsets is None else log.angle_offsets[keep].copy(),
     )
+
+
+LAST_BIT = 1e-15
+"""The relative size of :func:`perturb_odometry`'s change: a few units in the last place of
+a double (whose spacing is 2.2e-16 relative)."""
+
+
+def perturb_odometry(log: Log, seed: int, relative: float = LAST_BIT) -> Log:
+    """A copy of ``log`` whose odometry is multiplied by ``1 + relative * ε``, ``ε`` standard
+    normal, one per value, drawn with ``seed``.
+
+    With the default ``relative`` this is what the same code on another CPU does (fused
+    multiply-adds, other library builds): a result that changes much under it is not robust
+    (issue 10). ``fhslam slam LOG --last-bit SEED`` runs it.
+
+    Raises
+    ------
+    ValueError
+        If ``relative`` is negative or not a finite number.
+    """
+    rel = _check_non_negative("relative", relative)
+    eps = np.random.default_rng(seed).standard_normal(log.odometry.shape)
+    return replace(log, odometry=log.odometry * (1 + rel * eps))

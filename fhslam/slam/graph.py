@@ -181,10 +181,10 @@ class GraphSlamParams:
         A closure that would move its keyframe by more than this (metres)... With 0.3 m the
         pillared hall (``hall``, 1 mm of range noise, 10 % of the scans dropped) came back
         to its start with its estimate within 2 cm, and a single closure against the first
-        keyframes, 11-24 cm off (score 0.56-0.57: at the start a target has no keyframes
-        before it), moved it there unchecked for five of eight last-bit draws: ATE 6-12 cm
+        keyframes, 11-24 cm off (scores about 0.56: at the start a target has no keyframes
+        before it), moved it there unchecked for six of eight last-bit draws: ATE 6-12 cm
         instead of 0.9. With 0.1 m it waits, and no shared log's relation error changed by
-        more than 1 %, also with range noise, dropped scans or last-bit noise.
+        more than 1.5 %, also with range noise, dropped scans or last-bit noise.
     loop_confirm_deg : float
         ... or turn it by more than this (degrees) is held until an independent closure
         within ``loop_confirm_window`` keyframes agrees: its query shares no keyframe with

@@ -51,6 +51,7 @@ _API: dict[str, str] = {
     "load_world": "fhslam.sim",
     "simulate": "fhslam.sim",
     "degrade": "fhslam.sim",
+    "perturb_odometry": "fhslam.sim",
 }
 
 __all__ = sorted(_API)
@@ -80,7 +81,7 @@ if TYPE_CHECKING:  # for type checkers and IDEs: the same names, eagerly
     from fhslam.pipeline import METHODS, SlamResult, run_backend, run_slam
     from fhslam.reference_map import ReferenceMap
     from fhslam.scan import Scan, scan_to_points
-    from fhslam.sim import degrade, load_world, simulate
+    from fhslam.sim import degrade, load_world, perturb_odometry, simulate
     from fhslam.slam import (
         EKFLineSLAM,
         EKFParams,

@@ -526,6 +526,17 @@ def _fraction(text: str) -> float:
     return value
 
 
+def _seed(text: str) -> int:
+    """An argparse type: a random seed, a whole number 0 or more."""
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"not a whole number: {text!r}") from None
+    if value < 0:
+        raise argparse.ArgumentTypeError(f"must be a whole number >= 0, got {text}")
+    return value
+
+
 def _positive_int(text: str) -> int:
     """An argparse type: a whole number 1 or more."""
     try:
@@ -650,14 +661,14 @@ def build_parser() -> argparse.ArgumentParser:
     )
     g.add_argument(
         "--degrade-seed",
-        type=int,
+        type=_seed,
         default=0,
         metavar="N",
         help="seed of the noise, dropped scans and clutter (default 0)",
     )
     g.add_argument(
         "--last-bit",
-        type=int,
+        type=_seed,
         metavar="SEED",
         help="multiply the odometry by (1 + 1e-15 e), e standard normal drawn with SEED: what "
         "the same code on another CPU does",

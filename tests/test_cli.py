@@ -910,7 +910,9 @@ def test_slam_robustness_options_run_the_degraded_log(short_clf, tmp_path, capsy
         ("--drop-scans", "-0.1"),
         ("--clutter", "nan"),
         ("--degrade-seed", "x"),
+        ("--degrade-seed", "-1"),
         ("--last-bit", "1.5"),
+        ("--last-bit", "-2"),
     ],
 )
 def test_slam_bad_robustness_option_is_a_usage_error(short_clf, tmp_path, option, value):

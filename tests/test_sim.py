@@ -699,6 +699,8 @@ def test_degrade_works_without_truth_or_hits(paper_log):
         ({"range_noise": float("inf")}, "range_noise"),
         ({"range_noise": True}, "range_noise"),
         ({"range_noise": "1 mm"}, "range_noise"),
+        ({"seed": -1}, "seed"),
+        ({"seed": 1.5}, "seed"),
     ],
 )
 def test_degrade_rejects_bad_arguments(paper_log, kwargs, match):
@@ -762,6 +764,9 @@ def test_perturb_odometry_changes_the_last_bits_only(paper_log):
     for bad in (-1e-15, float("nan"), "tiny"):
         with pytest.raises(ValueError, match="relative"):
             perturb_odometry(paper_log, seed=1, relative=bad)
+    for bad in (-1, 0.5, True):
+        with pytest.raises(ValueError, match="seed"):
+            perturb_odometry(paper_log, seed=bad)
 
 
 # ------------------------------------------------------------------- how long a route is

@@ -35,6 +35,12 @@ def _check_non_negative(name: str, value: float, unit: str = "") -> float:
     return f
 
 
+def _check_seed(seed) -> int:
+    if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
+        raise ValueError(f"seed must be a whole number >= 0, got {seed!r}")
+    return int(seed)
+
+
 def _check_fraction(name: str, value: float) -> float:
     if isinstance(value, bool):
         raise ValueError(f"{name} must be a number in [0, 1), got {value!r}")
@@ -104,14 +110,15 @@ def degrade(
     Raises
     ------
     ValueError
-        If a fraction is outside [0, 1) or not a number, or ``resolution`` or
-        ``range_noise`` is negative or not a finite number.
+        If a fraction is outside [0, 1) or not a number, ``resolution`` or ``range_noise``
+        is negative or not a finite number, or ``seed`` is not a whole number >= 0.
     """
     drop = _check_fraction("drop_fraction", drop_fraction)
     clutter = _check_fraction("clutter_fraction", clutter_fraction)
     if not (np.isfinite(resolution) and resolution >= 0):
         raise ValueError(f"resolution must be >= 0, got {resolution!r}")
     sigma = _check_non_negative("range_noise", range_noise, " of metres")
+    seed = _check_seed(seed)
     # Three independent streams; the first two are what they were before range noise.
     drop_rng, clutter_rng, noise_rng = (
         np.random.default_rng(s) for s in np.random.SeedSequence(seed).spawn(3)
@@ -184,8 +191,10 @@ def perturb_odometry(log: Log, seed: int, relative: float = LAST_BIT) -> Log:
     Raises
     ------
     ValueError
-        If ``relative`` is negative or not a finite number.
+        If ``relative`` is negative or not a finite number, or ``seed`` is not a whole
+        number >= 0.
     """
     rel = _check_non_negative("relative", relative)
+    seed = _check_seed(seed)
     eps = np.random.default_rng(seed).standard_normal(log.odometry.shape)
     return replace(log, odometry=log.odometry * (1 + rel * eps))

@@ -317,8 +317,8 @@ for r in one_run("paper", "medium", SEED, ("fht", "classical", "ekf", "odometry"
 # | better than Kalman filtering ("can only deal with linear problem") | **does not hold** | the EKF handles the nonlinear line SLAM well: median ATE 1.3 / 1.7 / 2.3 cm (worst 3.7 cm) against FH-SLAM's 2.6 / 4.0 / 5.6 cm (worst 9.1 cm), lowest of the five methods at every level (Exercise 7.1); median map error 1.8 cm against 1.1–2.3 cm. It is also faster here: about half FH-SLAM's time per step, with about 18 lines in its state (an EKF's update grows with the square of that number) |
 #
 # Further notes. FH-SLAM graph, the package's pose-graph method (not in the paper), lies between
-# the EKF and FH-SLAM at `medium` and `high` (median 3.1 and 4.1 cm) and takes about 0.6 times
-# FH-SLAM's time per step (its loop closures run on a second thread).
+# the EKF and FH-SLAM at every level (median 2.5, 2.6 and 3.5 cm at `low`, `medium` and `high`) and
+# takes about 0.6 times FH-SLAM's time per step (its loop closures run on a second thread).
 # Split-and-merge, which the paper does not mention, is about as precise as the fast Hough
 # transform (rms Δρ 1.2 cm, Δθ 0.5°) and several times slower (section 1's table). And every method, not only FH-SLAM, depends on a polygonal world, as the paper's
 # conclusion says; the real laser logs (notebook 08) test that.

@@ -57,7 +57,7 @@ def right_stats(rows, method, level):
 
 def test_lowest_ate_on_the_committed_sweep_is_the_ekf(sweep):
     ok = check_lowest_ate("d", sweep)
-    assert ok and "EKF line SLAM 2.3 cm, FH-SLAM graph 4.1 cm" in ok.message
+    assert ok and "EKF line SLAM 2.3 cm, FH-SLAM graph 3.5 cm" in ok.message
     assert "FH-SLAM (paper) 5.6 cm" in ok.message and "odometry 2.69 m" in ok.message
     fht = check_lowest_ate("a", sweep)
     assert fht.status == "wrong" and "5.6 cm" in fht.message and "Loop 3" in fht.message

@@ -469,83 +469,53 @@ def _bench(args: argparse.Namespace) -> None:
         print(bench.format_log_bench(result))
 
 
-def _positive(unit: str):
-    """An argparse type: a positive finite number of ``unit``."""
+def _number(ok, what: str):
+    """An argparse type: a number for which ``ok(value)`` holds; else "must be ``what``"."""
 
     def parse(text: str) -> float:
         try:
             value = float(text)
         except ValueError:
             raise argparse.ArgumentTypeError(f"not a number: {text!r}") from None
-        if not (value > 0 and value < float("inf")):
-            raise argparse.ArgumentTypeError(f"must be a positive number of {unit}, got {text}")
+        if not ok(value):  # NaN fails every comparison
+            raise argparse.ArgumentTypeError(f"must be {what}, got {text}")
         return value
 
     return parse
 
 
-_positive_metres = _positive("metres")
-
-
-def _non_negative_seconds(text: str) -> float:
-    """An argparse type: a finite number of seconds, 0 or more."""
-    try:
-        value = float(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"not a number: {text!r}") from None
-    if not (value >= 0 and value < float("inf")):
-        raise argparse.ArgumentTypeError(f"must be a finite number of seconds >= 0, got {text}")
-    return value
+def _positive(unit: str):
+    """An argparse type: a positive finite number of ``unit``."""
+    return _number(lambda v: 0 < v < float("inf"), f"a positive number of {unit}")
 
 
 def _non_negative(unit: str):
     """An argparse type: a finite number of ``unit``, 0 or more."""
+    return _number(lambda v: 0 <= v < float("inf"), f"a finite number of {unit} >= 0")
 
-    def parse(text: str) -> float:
+
+_positive_metres = _positive("metres")
+_non_negative_seconds = _non_negative("seconds")
+_fraction = _number(lambda v: 0 <= v < 1, "a share from 0 up to (not including) 1")
+
+
+def _whole(minimum: int):
+    """An argparse type: a whole number ``minimum`` or more."""
+
+    def parse(text: str) -> int:
         try:
-            value = float(text)
+            value = int(text)
         except ValueError:
-            raise argparse.ArgumentTypeError(f"not a number: {text!r}") from None
-        if not (value >= 0 and value < float("inf")):
-            raise argparse.ArgumentTypeError(f"must be a finite number of {unit} >= 0, got {text}")
+            raise argparse.ArgumentTypeError(f"not a whole number: {text!r}") from None
+        if value < minimum:
+            raise argparse.ArgumentTypeError(f"must be a whole number >= {minimum}, got {text}")
         return value
 
     return parse
 
 
-def _fraction(text: str) -> float:
-    """An argparse type: a share in [0, 1)."""
-    try:
-        value = float(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"not a number: {text!r}") from None
-    if not 0 <= value < 1:
-        raise argparse.ArgumentTypeError(
-            f"must be a share from 0 up to (not including) 1, got {text}"
-        )
-    return value
-
-
-def _seed(text: str) -> int:
-    """An argparse type: a random seed, a whole number 0 or more."""
-    try:
-        value = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"not a whole number: {text!r}") from None
-    if value < 0:
-        raise argparse.ArgumentTypeError(f"must be a whole number >= 0, got {text}")
-    return value
-
-
-def _positive_int(text: str) -> int:
-    """An argparse type: a whole number 1 or more."""
-    try:
-        value = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"not a whole number: {text!r}") from None
-    if value < 1:
-        raise argparse.ArgumentTypeError(f"must be a whole number >= 1, got {text}")
-    return value
+_seed = _whole(0)  # a random seed
+_positive_int = _whole(1)
 
 
 def _log_arguments(p: argparse.ArgumentParser) -> None:

@@ -140,3 +140,26 @@ def test_turning_into_unseen_space_the_previous_scan_places_the_scan():
     assert t.sure and t.matched  # measured score 0.71 (0.35 against the map alone)
     assert np.hypot(*(t.pose[:2] - truth[:2])) < 0.01  # measured: < 1 mm
     assert abs(np.degrees(t.pose[2] - truth[2])) < 0.2
+
+
+@pytest.mark.xfail(
+    strict=True,
+    reason=(
+        "the keyframe clouds' voxel grid runs along the walls when the robot drives parallel "
+        "to them, and which noisy point each 2 cm cell keeps tilts every keyframe's walls the "
+        "same way: +0.8 to +1.3 degrees over seeds 0-5 (README, 'Where the ring's heading "
+        "drift comes from'); a grid turned by 22.5 degrees gives 0.15 but was not adopted"
+    ),
+)
+def test_a_straight_corridor_with_perfect_odometry_keeps_its_heading():
+    """The ring's first straight (480 scans, 47 m; 1 cm range noise) with perfect odometry:
+    the front end's tracked heading ends within 0.5° of the truth. Without range noise it
+    ends 0.05° off, with the correlative search alone 0.00° (it keeps the prediction)."""
+    from fhslam.sim import OdometryNoise
+    from fhslam.slam.graph import GraphFastHoughSLAM
+
+    log = simulate(load_world("ring"), seed=0, odometry=OdometryNoise.none(), max_scans=480)
+    slam = GraphFastHoughSLAM(background=False)
+    last = [slam.step(log.scan(k), log.odometry[k]).pose for k in range(len(log))][-1]
+    off = np.degrees(np.angle(np.exp(1j * (last[2] - log.truth[-1, 2]))))
+    assert abs(off) <= 0.5, f"{off:.2f} degrees"

@@ -161,13 +161,12 @@ def test_a_return_out_of_the_local_searchs_reach_is_closed_globally():
     """The ``offices`` floor driven twice, blind for 60 scans (4.6 m) shortly before the end
     of the first lap while the odometry turns 20 degrees too far: the estimate comes back
     20 degrees off, beyond the local search's ± 15 degrees, and nothing closes the lap. The
-    global search (``global_every``) does. The lap (62 m) is shorter than the default reach
-    of the local search (110 m of travel since the last closure), so that reach is cut to
-    10 m here (``loop_max_radius`` 3 m)."""
+    global search (``global_every``, from ``global_after`` = 10 m without a closure on)
+    does."""
     log = _blind_turn(simulate(load_world("offices"), seed=0, laps=2), 20, 8, 60, 30)
-    local = run_slam(log, "graph", GraphSlamParams(global_every=0, loop_max_radius=3.0))
+    local = run_slam(log, "graph", GraphSlamParams(global_every=0))
     assert ate(local.poses, log.truth).rmse >= 0.5  # measured 0.97 m
-    slam = GraphFastHoughSLAM(GraphSlamParams(loop_max_radius=3.0))
+    slam = GraphFastHoughSLAM()
     r = run_backend(slam, log)
     errors = _closure_errors(slam, log)
     assert len(errors) >= 100 and errors.max() <= 0.3  # measured 146 closures, <= 0.10 m
@@ -206,10 +205,12 @@ def test_a_candidate_that_failed_for_the_previous_keyframe_waits_a_keyframe(
     for skip in (True, False):
         searches = []  # (keyframe, candidate, tracking, passed)
 
-        def spy(*args, searches=searches):
-            m = match(*args)
-            f = inspect.currentframe().f_back.f_locals  # GraphFastHoughSLAM._close_loops
-            searches.append((f["i"], f["j"], f["tracking"], m.score >= f["p"].loop_min_score))
+        def spy(*args, searches=searches, **kwargs):
+            m = match(*args, **kwargs)
+            caller = inspect.currentframe().f_back
+            if caller.f_code.co_name == "_close_loops":  # not the global search
+                f = caller.f_locals
+                searches.append((f["i"], f["j"], f["tracking"], m.score >= f["p"].loop_min_score))
             return m
 
         monkeypatch.setattr(graph, "match_clouds", spy)
@@ -219,9 +220,9 @@ def test_a_candidate_that_failed_for_the_previous_keyframe_waits_a_keyframe(
         repeats = [(i, j) for i, j, track, _ in searches if not track and (i - 1, j) in failed]
         runs[skip] = (len(searches), repeats, ate(r.poses, three_laps.truth).rmse)
     (n_skip, repeats_skip, ate_skip), (n_all, repeats_all, ate_all) = runs[True], runs[False]
-    assert repeats_skip == [] and len(repeats_all) >= 3  # measured 6
-    assert n_skip < n_all  # measured 112 and 119
-    assert ate_skip <= max(0.02, 1.25 * ate_all)  # measured 0.9 and 1.5 cm
+    assert repeats_skip == [] and len(repeats_all) >= 3, repeats_all  # measured 5
+    assert n_skip < n_all, (n_skip, n_all)  # measured 107 and 110
+    assert ate_skip <= max(0.02, 1.25 * ate_all), (ate_skip, ate_all)  # measured 1.1, 1.1 cm
 
 
 @pytest.mark.parametrize("glitch", [False, True])
@@ -410,6 +411,8 @@ def test_without_loop_closures_no_loop_edges(three_laps):
         ("loop_consistency", 0.0, "loop_consistency must be > 0"),
         ("loop_confirm_window", 0, "loop_confirm_window must be >= 1"),
         ("global_every", -1, "global_every must be >= 0"),
+        ("global_after", -1.0, "global_after must be >= 0"),
+        ("global_after", float("nan"), "global_after must be >= 0"),
         ("global_min_score", 1.5, r"global_min_score must be in \[0, 1\]"),
         ("global_max_ambiguity", 0.0, r"global_max_ambiguity must be in \(0, 1\]"),
         ("global_window_deg", 0.0, r"global_window_deg must be in \(0, 180\]"),
@@ -423,11 +426,9 @@ def test_bad_parameters_are_named(field, value, message):
 # --------------------------------------------------------------------------- real logs
 
 
-CLINIC_NOISE = (
-    "Freiburg hospital with 1 mm of range noise (fhslam.sim.degrade, seed 0): the tracker's "
-    "heading, among people in open halls, is off by 25-35 degrees when the robot returns to "
-    "its start (12-25 unperturbed), and the estimate 85-106 m: beyond the global search's "
-    "window (5 % of the 900 m travelled, 30 degrees). 3.14 m (10 % of the scans dropped: 4.47 m)"
+CLINIC_DROPS_3 = (
+    "Freiburg hospital with 10 % of the scans dropped, degrade seed 3 (1 of 20 perturbed "
+    "draws measured at stop 31; the other 19 0.117-0.134 m): 2.13 m"
 )
 
 
@@ -463,11 +464,11 @@ def _relations_error(real_data, name, odometry_noise_seed=None, drop_fraction=0.
 # machine). The assertion is the limit: the measured values leave room for last-bit
 # differences between CPUs. README: the table and the commands.
 REAL_LOGS = {
-    "intel": (0.05, 0.0143),
+    "intel": (0.05, 0.0142),
     "aces": (0.06, 0.0347),
-    "mit-csail": (0.06, 0.0264),
-    "fr079": (0.08, 0.0303),
-    "fr-clinic": (0.15, 0.126),
+    "mit-csail": (0.06, 0.0265),
+    "fr079": (0.08, 0.0305),
+    "fr-clinic": (0.15, 0.127),
 }
 
 
@@ -495,38 +496,68 @@ def test_the_hospitals_relations_under_a_minute_hold(real_data):
     assert e.trans_mean <= 0.105, f"{e.trans_mean:.4f} m"
 
 
-@pytest.mark.xfail(strict=True, reason=CLINIC_NOISE)
-def test_the_hospital_with_range_noise(real_data):
-    """Issue 10's robustness: 1 mm of Gaussian noise on every range may change the relation
-    error by at most 25 % (or 1 cm)."""
+def _clinic_error(params=None, **degraded) -> float:
+    """The hospital's mean translational relation error (metres) of a run of the default
+    SLAM (or ``params``) on the log degraded by ``degraded`` (:func:`fhslam.sim.degrade`)."""
     from fhslam.datasets import find_dataset, load_log
     from fhslam.io import read_relations
     from fhslam.metrics import relations_error
 
-    r = run_slam(degrade(load_log("fr-clinic"), range_noise=0.001, seed=0))
-    e = relations_error(
-        r.timestamps, r.poses, *read_relations(find_dataset("fr-clinic", "relations"))
-    )
-    assert e.trans_mean <= max(1.25 * 0.126, 0.126 + 0.01), f"{e.trans_mean:.4f} m"
+    r = run_slam(degrade(load_log("fr-clinic"), **degraded), params=params)
+    rel = read_relations(find_dataset("fr-clinic", "relations"))
+    return relations_error(r.timestamps, r.poses, *rel).trans_mean
+
+
+@pytest.mark.parametrize(
+    "degraded",
+    [
+        {"range_noise": 0.001, "seed": 0},
+        {"drop_fraction": 0.1, "seed": 0},
+        pytest.param(
+            {"drop_fraction": 0.1, "seed": 3},
+            marks=pytest.mark.xfail(strict=True, reason=CLINIC_DROPS_3),
+        ),
+    ],
+    ids=["range-noise", "dropped-scans", "dropped-scans-seed-3"],
+)
+def test_the_hospital_is_robust(real_data, degraded):
+    """Issue 10's robustness: 1 mm of Gaussian noise on every range, or 10 % of the scans
+    dropped, may change the relation error by at most 25 % (or 1 cm). Measured 0.1277 m
+    with the noise and 0.1303 m with the drops (0.127 m unperturbed); before the global
+    search looked where the odometry puts the robot, and from 10 m without a closure on,
+    3.14 m and 4.47 m: the return to the start lay 85-146 m and 25-40 degrees off the
+    estimate."""
+    measured = REAL_LOGS["fr-clinic"][1]
+    e = _clinic_error(**degraded)
+    assert e <= max(1.25 * measured, measured + 0.01), f"{e:.4f} m"
+
+
+def test_the_hospitals_return_is_found_where_the_odometry_puts_it(real_data):
+    """The same run with 1 mm of range noise, the global search around the graph's estimate
+    only (``global_from_odometry=False``): the tracker's heading, fooled among people in
+    open halls, puts the return far outside the window and nothing closes it (measured
+    3.14 m; 0.128 m with the odometry's guess, above)."""
+    e = _clinic_error(GraphSlamParams(global_from_odometry=False), range_noise=0.001, seed=0)
+    assert e >= 1.0, f"{e:.4f} m"
 
 
 @pytest.mark.parametrize("seed", [1, 2])
 def test_mit_csail_does_not_turn_on_the_last_bit(real_data, seed):
     """The odometry multiplied by (1 + 1e-15 ε): before closures that move a keyframe far
     waited for an independent one, seed 2 gave 0.394 m instead of 0.043 m; measured now
-    0.0269, 0.0268 and 0.0264 m for seeds 1, 2 and unperturbed."""
+    0.0269, 0.0268 and 0.0265 m for seeds 1, 2 and unperturbed."""
     e = _relations_error(real_data, "mit-csail", odometry_noise_seed=seed)
     assert e.trans_mean <= 0.035, f"seed {seed}: {e.trans_mean:.4f} m"
 
 
-@pytest.mark.parametrize(("name", "every_scan"), [("mit-csail", 0.0264), ("fr079", 0.0303)])
+@pytest.mark.parametrize(("name", "every_scan"), [("mit-csail", 0.0265), ("fr079", 0.0305)])
 def test_dropped_scans_change_little(real_data, name, every_scan):
     """10 % of the scans dropped (issue 10: no log's error may change by more than 25 % or
     1 cm). MIT CSAIL: a 5 Hz laser then turns up to 50 degrees between two scans, into space
     the local map has not seen; before the tracker matched such a scan against the previous
     one, five doubtful scans followed the odometry and forced a keyframe 14-17 degrees off:
     0.73 m (measured now 0.0282 m). Freiburg 079: with the bag's laser mount (+0.04 m) the
-    result swung between 0.064 m and 0.040 m (measured now 0.0308 m)."""
+    result swung between 0.064 m and 0.040 m (measured now 0.0310 m)."""
     e = _relations_error(real_data, name, drop_fraction=0.1)
     assert e.n_used < e.n_total  # relations at dropped scans cannot be evaluated
     bound = max(1.25 * every_scan, every_scan + 0.01)

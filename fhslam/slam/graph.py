@@ -34,13 +34,13 @@ line describes. What this module adds, each measured in the README:
    keyframe with its own: one door off in a corridor, or a corridor's width off where a
    corridor meets its start again, a single match looks as good as the right one, and so does
    the next query's against the same target.
-5. **A global search** once the robot has gone ``global_after`` metres without a closure
-   (``global_every``): the last few keyframes are matched against every old keyframe
-   within a window that grows with the distance since the last closure, by branch and
-   bound, around two guesses - the graph's estimate and where the odometry since the last
-   closure puts the robot (a tracker that was fooled among people does not fool the
-   odometry, and the other way round); a match must be unique and is held until a second
-   one, from a query that shares no keyframe with it, agrees.
+5. **A global search** (``global_every``): the last few keyframes are matched against
+   every old keyframe within a window that grows with the distance since the last closure,
+   by branch and bound, around where the odometry since the last closure puts the robot
+   (from ``global_after`` metres without a closure on: a tracker fooled among people does
+   not fool the odometry) and, once the local search no longer reaches, around the graph's
+   estimate (an odometry that glitched does not fool the tracker); a match must be unique
+   and is held until a second one, from a query that shares no keyframe with it, agrees.
 6. **The map of reference lines** is built at the end by Loop 2 itself: each keyframe's fast
    Hough lines, placed at its optimised pose, are matched with and merged into the map
    (Fig. 11) - the paper's map, from better poses.
@@ -213,9 +213,11 @@ class GraphSlamParams:
         coarse grid, then the fine grid) against the clouds of every keyframe at least
         ``global_after`` metres of travel older, within ``± loop_growth × distance``
         metres (at least ``loop_max_window``, at most ``global_max_window``) and
-        ``± global_window_deg`` of a guess: first the graph's estimate, then (if it found
-        nothing and ``global_from_odometry``) where the odometry since the last closure
-        puts the robot, if that lies more than half a window away. A match is taken only
+        ``± global_window_deg`` of a guess: the graph's estimate, once the local search's
+        radius has reached ``loop_max_radius`` (110 m of travel by default; before that the
+        local search looks there), and then, if ``global_from_odometry`` and nothing was
+        found, where the odometry since the last closure puts the robot, if that lies more
+        than half a window away. A match is taken only
         if it scores at least ``global_min_score``, is unique (nothing more than
         ``loop_window`` metres away scores over ``global_max_ambiguity`` of its coarse
         score) and refines point-to-line like a local closure; and then only as a
@@ -228,8 +230,9 @@ class GraphSlamParams:
         relation error falls from 1.13 m to 0.127 m (README, the hospital's section).
     global_after : float
         See ``global_every``: metres of travel without a closure before the global search
-        starts. Until stop 31 it waited until the local search's radius was at its largest
-        (110 m); then the hospital's return was found with its unperturbed ranges only.
+        starts (around the odometry's guess). Until stop 31 it waited until the local
+        search's radius was at its largest (110 m), and looked around the estimate only:
+        the hospital's return was found with its unperturbed ranges only.
     global_from_odometry : bool
         See ``global_every``.
     global_keyframes : int
@@ -850,11 +853,14 @@ class GraphFastHoughSLAM:
 
     def _global_guesses(self, i: int, poses, win: float) -> list[NDArray[np.float64]]:
         """Where the global search looks for keyframe ``i`` (its pose in its own frame):
-        the graph's estimate, and where the odometry since the last closure puts it (the
+        the graph's estimate, once the local search no longer reaches far enough (its radius
+        at ``loop_max_radius``), and where the odometry since the last closure puts it (the
         keyframe at the last closure moved by the odometry's motion since), unless that
         lies within half the window of the estimate."""
         p = self.params
-        guesses = [np.zeros(3)]
+        reach = (p.loop_max_radius - p.loop_radius) / p.loop_growth
+        local = self._path[i] - self._last_loop_path < reach  # the local search still grows
+        guesses = [] if local else [np.zeros(3)]
         if p.global_from_odometry:
             a = int(np.searchsorted(self._path[: i + 1], self._last_loop_path))
             odo = compose(poses[a], relative(self._kf_odometry[a], self._kf_odometry[i]))

@@ -68,9 +68,10 @@
 #   match enters the graph only with a high enough score and enough points on a line at a small
 #   rms distance, as a robust (Cauchy) edge. After each optimisation a closure whose error stays
 #   too large is switched off and the graph optimised again, so a few wrong closures cannot bend
-#   the trajectory. After more than 110 m without a closure (neither log here has such a
-#   stretch; the Freiburg hospital has 900 m) a global search matches the last nine keyframes
-#   against every old one, and takes a match only if it is unique and a second one agrees.
+#   the trajectory. After 10 m without a closure a global search matches the last nine
+#   keyframes against every old one around where the odometry puts the robot (after 110 m, a
+#   stretch neither log here has but the Freiburg hospital has, around the estimate too), and
+#   takes a match only if it is unique and a second one agrees.
 # - **The reference-line map is built at the end by Loop 2 itself:** each keyframe's fast Hough
 #   lines, placed at its optimised pose, are matched with and merged into the map — the paper's
 #   map, from better poses.

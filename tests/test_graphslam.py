@@ -547,6 +547,41 @@ def test_the_hospitals_return_is_found_where_the_odometry_puts_it(real_data):
     assert e >= 1.0, f"{e:.4f} m"
 
 
+HOSPITAL_CURVED_WALL = (
+    "the tracker turns 13-16 degrees too far over the hospital's scans 2541-2564 (a curved "
+    "wall 3-5 m away, people about), where the odometry agrees with the benchmark's "
+    "relations to 0.01 degrees; scan-to-scan matching without a map does the same (+14 "
+    "degrees). The README's hospital section: the 'second place' of the return."
+)
+
+
+@pytest.mark.xfail(strict=True, reason=HOSPITAL_CURVED_WALL)
+def test_the_hospitals_curved_wall_turns_as_the_relations_say(real_data):
+    """The known failure behind the hospital's second place, on 60 scans (half a second):
+    the default SLAM from scan 2520 to 2579, its headings between scans of the benchmark's
+    relations there (relations 35.2, 44.8 and 16.7 degrees; measured 40.8, 54.1 and 23.9).
+    Strict: a change that fixes it must say so."""
+    import dataclasses
+
+    from fhslam.datasets import find_dataset, load_log
+    from fhslam.io import read_relations
+
+    full = load_log("fr-clinic")
+    lo, hi = 2520, 2580
+    cut = {f: getattr(full, f)[lo:hi] for f in ("timestamps", "ranges", "odometry")}
+    log = dataclasses.replace(full, angle_offsets=full.angle_offsets[lo:hi], **cut)
+    r = run_slam(log)
+    t1, t2, z = read_relations(find_dataset("fr-clinic", "relations"))
+    pairs = [(2541, 2551), (2546, 2556), (2551, 2561)]
+    for a, b in pairs:
+        (q,) = np.flatnonzero(
+            (np.abs(t1 - full.timestamps[a]) < 1e-3) & (np.abs(t2 - full.timestamps[b]) < 1e-3)
+        )
+        ours = r.poses[b - lo, 2] - r.poses[a - lo, 2]
+        off = np.degrees(np.angle(np.exp(1j * (ours - z[q, 2]))))
+        assert abs(off) <= 3.0, f"scans {a}-{b}: {off:+.1f} degrees off the relation"
+
+
 @pytest.mark.parametrize("seed", [1, 2])
 def test_mit_csail_does_not_turn_on_the_last_bit(real_data, seed):
     """The odometry multiplied by (1 + 1e-15 ε): before closures that move a keyframe far

@@ -448,19 +448,19 @@ def _plain_run(name):
     return r.timestamps, r.poses
 
 
-def _relations_error(real_data, name, odometry_noise_seed=None, drop_fraction=0.0):
+def _relations_error(real_data, name, odometry_noise_seed=None, drop_fraction=0.0, range_noise=0.0):
     from fhslam.datasets import find_dataset, load_log
     from fhslam.io import read_relations
     from fhslam.metrics import relations_error
 
     rel = read_relations(find_dataset(name, "relations"))
-    if odometry_noise_seed is None and not drop_fraction:
+    if odometry_noise_seed is None and not drop_fraction and not range_noise:
         return relations_error(*_plain_run(name), *rel)
     log = load_log(name)  # found where the real_data fixture found them
     if odometry_noise_seed is not None:  # last-bit noise: what another CPU may do
         log = perturb_odometry(log, odometry_noise_seed)
-    if drop_fraction:
-        log = degrade(log, drop_fraction=drop_fraction, seed=0)
+    if drop_fraction or range_noise:
+        log = degrade(log, drop_fraction=drop_fraction, range_noise=range_noise, seed=0)
     r = run_slam(log)  # the default method, the same defaults for every log
     return relations_error(r.timestamps, r.poses, *rel)
 
@@ -591,14 +591,41 @@ def test_mit_csail_does_not_turn_on_the_last_bit(real_data, seed):
     assert e.trans_mean <= 0.035, f"seed {seed}: {e.trans_mean:.4f} m"
 
 
-@pytest.mark.parametrize(("name", "every_scan"), [("mit-csail", 0.0264), ("fr079", 0.0303)])
+@pytest.mark.parametrize("name", ["intel", "aces", "mit-csail", "fr079"])
+def test_range_noise_changes_little(real_data, name):
+    """1 mm of Gaussian noise on every range (issue 10: no log's error may change by more
+    than 25 % or 1 cm; the hospital: ``test_the_hospital_is_robust``). Measured (degrade seed
+    0): Intel 0.0143, ACES 0.0345, MIT CSAIL 0.0269, Freiburg 079 0.0302 m; every scan
+    0.0143, 0.0347, 0.0264, 0.0303 m."""
+    every_scan = REAL_LOGS[name][1]
+    e = _relations_error(real_data, name, range_noise=0.001)
+    assert e.n_used == e.n_total
+    bound = max(1.25 * every_scan, every_scan + 0.01)
+    assert e.trans_mean <= bound, f"{name}: {e.trans_mean:.4f} m (every scan {every_scan} m)"
+
+
+@pytest.mark.parametrize(("name", "seed"), [("intel", 1), ("fr079", 2)])
+def test_the_last_bit_changes_little(real_data, name, seed):
+    """The odometry multiplied by (1 + 1e-15 epsilon), what another CPU may do (MIT CSAIL and
+    ACES: their own tests). Measured: Intel 0.0143 m (seed 1), Freiburg 079 0.0304 m (seed
+    2); every scan 0.0143 and 0.0303 m."""
+    every_scan = REAL_LOGS[name][1]
+    e = _relations_error(real_data, name, odometry_noise_seed=seed)
+    assert e.trans_mean <= max(1.1 * every_scan, every_scan + 0.002), f"{e.trans_mean:.4f} m"
+
+
+@pytest.mark.parametrize(
+    ("name", "every_scan"),
+    [("intel", 0.0143), ("aces", 0.0347), ("mit-csail", 0.0264), ("fr079", 0.0303)],
+)
 def test_dropped_scans_change_little(real_data, name, every_scan):
     """10 % of the scans dropped (issue 10: no log's error may change by more than 25 % or
     1 cm). MIT CSAIL: a 5 Hz laser then turns up to 50 degrees between two scans, into space
     the local map has not seen; before the tracker matched such a scan against the previous
     one, five doubtful scans followed the odometry and forced a keyframe 14-17 degrees off:
     0.73 m (measured now 0.0282 m). Freiburg 079: with the bag's laser mount (+0.04 m) the
-    result swung between 0.064 m and 0.040 m (measured now 0.0309 m)."""
+    result swung between 0.064 m and 0.040 m (measured now 0.0309 m). Intel 0.0148 m, ACES
+    0.0348 m."""
     e = _relations_error(real_data, name, drop_fraction=0.1)
     assert e.n_used < e.n_total  # relations at dropped scans cannot be evaluated
     bound = max(1.25 * every_scan, every_scan + 0.01)

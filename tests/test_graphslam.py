@@ -551,13 +551,14 @@ HOSPITAL_CURVED_WALL = (
     "the tracker turns 13-16 degrees too far over the hospital's scans 2541-2564 (a curved "
     "wall 3-5 m away, people about), where the odometry agrees with the benchmark's "
     "relations to 0.01 degrees; scan-to-scan matching without a map does the same (+14 "
-    "degrees). The README's hospital section: the 'second place' of the return."
+    "degrees). The README's hospital section: why the return closed at scans 2599-2644 "
+    "leaves the start out of reach."
 )
 
 
 @pytest.mark.xfail(strict=True, reason=HOSPITAL_CURVED_WALL)
 def test_the_hospitals_curved_wall_turns_as_the_relations_say(real_data):
-    """The known failure behind the hospital's second place, on 60 scans (half a second):
+    """The known failure behind the hospital's map of scans 2599-2644, on 60 scans (0.5 s):
     the default SLAM from scan 2520 to 2579, its headings between scans of the benchmark's
     relations there (relations 35.2, 44.8 and 16.7 degrees; measured 40.8, 54.1 and 23.9).
     Strict: a change that fixes it must say so."""

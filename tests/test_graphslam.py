@@ -7,6 +7,7 @@ import functools
 import numpy as np
 import pytest
 
+from fhslam.geometry import wrap_angle
 from fhslam.metrics import ate
 from fhslam.pipeline import run_backend, run_slam
 from fhslam.sim import OdometryNoise, degrade, load_world, perturb_odometry, simulate
@@ -465,6 +466,12 @@ def _relations_error(real_data, name, odometry_noise_seed=None, drop_fraction=0.
     return relations_error(r.timestamps, r.poses, *rel)
 
 
+def _issue_10_bound(every_scan: float) -> float:
+    """Issue 10's robustness: a perturbation may change a log's relation error by at most
+    25 % or 1 cm, whichever is larger."""
+    return max(1.25 * every_scan, every_scan + 0.01)
+
+
 # Mean translational relation error over all relations, metres, with the default method and
 # the same defaults for every log: (issue 10's limit, measured on this project's 2-core
 # machine). The assertion is the limit: the measured values leave room for last-bit
@@ -535,7 +542,7 @@ def test_the_hospital_is_robust(real_data, degraded):
     estimate."""
     measured = REAL_LOGS["fr-clinic"][1]
     e = _clinic_error(**degraded)
-    assert e <= max(1.25 * measured, measured + 0.01), f"{e:.4f} m"
+    assert e <= _issue_10_bound(measured), f"{e:.4f} m"
 
 
 def test_the_hospitals_return_is_found_where_the_odometry_puts_it(real_data):
@@ -579,7 +586,7 @@ def test_the_hospitals_curved_wall_turns_as_the_relations_say(real_data):
             (np.abs(t1 - full.timestamps[a]) < 1e-3) & (np.abs(t2 - full.timestamps[b]) < 1e-3)
         )
         ours = r.poses[b - lo, 2] - r.poses[a - lo, 2]
-        off = np.degrees(np.angle(np.exp(1j * (ours - z[q, 2]))))
+        off = np.degrees(wrap_angle(ours - z[q, 2]))
         assert abs(off) <= 3.0, f"scans {a}-{b}: {off:+.1f} degrees off the relation"
 
 
@@ -601,8 +608,9 @@ def test_range_noise_changes_little(real_data, name):
     every_scan = REAL_LOGS[name][1]
     e = _relations_error(real_data, name, range_noise=0.001)
     assert e.n_used == e.n_total
-    bound = max(1.25 * every_scan, every_scan + 0.01)
-    assert e.trans_mean <= bound, f"{name}: {e.trans_mean:.4f} m (every scan {every_scan} m)"
+    assert e.trans_mean <= _issue_10_bound(every_scan), (
+        f"{name}: {e.trans_mean:.4f} m (every scan {every_scan} m)"
+    )
 
 
 @pytest.mark.parametrize(("name", "seed"), [("intel", 1), ("fr079", 2)])
@@ -627,8 +635,9 @@ def test_dropped_scans_change_little(real_data, name):
     every_scan = REAL_LOGS[name][1]
     e = _relations_error(real_data, name, drop_fraction=0.1)
     assert e.n_used < e.n_total  # relations at dropped scans cannot be evaluated
-    bound = max(1.25 * every_scan, every_scan + 0.01)
-    assert e.trans_mean <= bound, f"{name}: {e.trans_mean:.4f} m (every scan {every_scan} m)"
+    assert e.trans_mean <= _issue_10_bound(every_scan), (
+        f"{name}: {e.trans_mean:.4f} m (every scan {every_scan} m)"
+    )
 
 
 @pytest.mark.parametrize("seed", [None, 1])

@@ -787,6 +787,47 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--jobs", type=int, default=-1, help="worker processes (default: all cores)")
     p.add_argument("--out", type=Path, help="write every run to this CSV file")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
+    g = p.add_argument_group(
+        "robustness checks",
+        "degrade every simulated log before its runs, as `fhslam slam` does "
+        "(fhslam.sim.degrade, fhslam.sim.perturb_odometry); the CSV file records it",
+    )
+    g.add_argument(
+        "--range-noise",
+        type=_non_negative("metres"),
+        default=0.0,
+        metavar="M",
+        help="Gaussian noise of M metres (standard deviation) on every valid range",
+    )
+    g.add_argument(
+        "--drop-scans",
+        type=_fraction,
+        default=0.0,
+        metavar="F",
+        help="drop this share of the scans (never the first), as lost laser messages",
+    )
+    g.add_argument(
+        "--clutter",
+        type=_fraction,
+        default=0.0,
+        metavar="F",
+        help="this share of each scan's valid beams returns short, as from people or chairs",
+    )
+    g.add_argument(
+        "--degrade-seed",
+        type=_seed,
+        default=0,
+        metavar="N",
+        help="seed of the noise, dropped scans and clutter (default 0)",
+    )
+    g.add_argument(
+        "--last-bit-draws",
+        type=_seed,
+        default=0,
+        metavar="K",
+        help="also run each log with its odometry multiplied by (1 + 1e-15 e), e drawn with "
+        "seeds 1..K: what the same code does on other CPUs (default 0: as simulated only)",
+    )
     p.set_defaults(run=_sweep)
 
     p = sub.add_parser(
@@ -860,6 +901,8 @@ def _sweep(args: argparse.Namespace) -> None:
 
     if not 1 <= args.seeds <= 1000:
         raise InputError(f"--seeds must be between 1 and 1000, got {args.seeds}")
+    if args.last_bit_draws > 100:
+        raise InputError(f"--last-bit-draws must be at most 100, got {args.last_bit_draws}")
     if args.jobs == 0:
         raise InputError("--jobs must not be 0 (-1: all cores)")
     world = load_world(args.world)  # a bad world is an error before any worker starts
@@ -875,6 +918,11 @@ def _sweep(args: argparse.Namespace) -> None:
         methods=args.methods,
         n_jobs=args.jobs,
         progress=not args.quiet,
+        range_noise=args.range_noise,
+        drop_fraction=args.drop_scans,
+        clutter_fraction=args.clutter,
+        degrade_seed=args.degrade_seed,
+        last_bit_draws=args.last_bit_draws,
     )
     if args.out is not None:
         compare.save_sweep(rows, args.out)

@@ -1,9 +1,10 @@
 """Monte-Carlo comparison of SLAM methods: the claims the paper makes without measuring them.
 
 :func:`slam_sweep` runs every method on the same simulated logs (seeds × odometry-noise
-levels) through :mod:`joblib`, so the same code runs on the local cores or, through joblib's
-backends, on a Dask or Ray cluster; every run is seeded, and the rows come back in a fixed
-order whatever the backend.
+levels; optionally degraded as real logs are, and each also with its odometry perturbed in
+the last bit: issue 10's robustness checks) through :mod:`joblib`, so the same code runs on
+the local cores or, through joblib's backends, on a Dask or Ray cluster; every run is
+seeded, and the rows come back in a fixed order whatever the backend.
 """
 
 from __future__ import annotations
@@ -27,7 +28,8 @@ from fhslam.errors import InputError, InputWarning
 from fhslam.io.files import atomic_output
 from fhslam.metrics import ate, map_error
 from fhslam.pipeline import METHODS, run_slam
-from fhslam.sim import OdometryNoise, load_world, simulate
+from fhslam.sim import OdometryNoise, degrade, load_world, perturb_odometry, simulate
+from fhslam.sim.degrade import check_degradation
 
 
 def noise_levels() -> dict[str, OdometryNoise]:
@@ -48,7 +50,13 @@ def noise_levels() -> dict[str, OdometryNoise]:
 
 @dataclass(frozen=True)
 class RunResult:
-    """One method on one simulated log."""
+    """One method on one simulated log.
+
+    The last five fields say how the log was changed before the run (all zero: not at all):
+    :func:`fhslam.sim.degrade`'s ``range_noise``, ``drop_fraction`` and ``clutter_fraction``
+    drawn with ``degrade_seed``, then :func:`fhslam.sim.perturb_odometry` with seed
+    ``last_bit`` (0: the odometry as simulated).
+    """
 
     method: str
     level: str
@@ -58,6 +66,11 @@ class RunResult:
     map_error: float
     ms_per_step: float
     n_map_lines: int
+    range_noise: float = 0.0
+    drop_fraction: float = 0.0
+    clutter_fraction: float = 0.0
+    degrade_seed: int = 0
+    last_bit: int = 0
 
 
 def _thread_lock_for_tqdm() -> None:
@@ -72,13 +85,38 @@ def _thread_lock_for_tqdm() -> None:
         std_tqdm.set_lock(threading.RLock())
 
 
-def one_run(world: str, level: str, seed: int, methods: Sequence[str]) -> list[RunResult]:
-    """Simulate ``world`` with noise ``level`` and ``seed``; run every method on that log."""
+def one_run(
+    world: str,
+    level: str,
+    seed: int,
+    methods: Sequence[str],
+    range_noise: float = 0.0,
+    drop_fraction: float = 0.0,
+    clutter_fraction: float = 0.0,
+    degrade_seed: int = 0,
+    last_bit: int = 0,
+) -> list[RunResult]:
+    """Simulate ``world`` with noise ``level`` and ``seed``; run every method on that log.
+
+    The log is first degraded (:func:`fhslam.sim.degrade` with ``range_noise``,
+    ``drop_fraction``, ``clutter_fraction`` and ``degrade_seed``) if any of those is not
+    zero, then its odometry perturbed in the last bit (:func:`fhslam.sim.perturb_odometry`
+    with seed ``last_bit``) if ``last_bit`` is not 0. The ATE is taken over the scans kept.
+    """
     _thread_lock_for_tqdm()
     with warnings.catch_warnings():  # a world file's warnings: given once, before the sweep
         warnings.simplefilter("ignore", InputWarning)
         w = load_world(world)
     log = simulate(w, seed=seed, odometry=noise_levels()[level])
+    changed = {
+        "range_noise": range_noise,
+        "drop_fraction": drop_fraction,
+        "clutter_fraction": clutter_fraction,
+    }
+    if any(changed.values()):
+        log = degrade(log, seed=degrade_seed, **changed)
+    if last_bit:
+        log = perturb_odometry(log, last_bit)
     odo = ate(log.odometry, log.truth).rmse
     out = []
     for m in methods:
@@ -95,6 +133,9 @@ def one_run(world: str, level: str, seed: int, methods: Sequence[str]) -> list[R
                 map_error=map_error(r.map, log.world.walls) if r.map else float("nan"),
                 ms_per_step=ms,
                 n_map_lines=len(r.map),
+                **changed,
+                degrade_seed=degrade_seed,
+                last_bit=last_bit,
             )
         )
     return out
@@ -107,11 +148,22 @@ def slam_sweep(
     methods: Sequence[str] = tuple(METHODS),
     n_jobs: int = -1,
     progress: bool = True,
+    range_noise: float = 0.0,
+    drop_fraction: float = 0.0,
+    clutter_fraction: float = 0.0,
+    degrade_seed: int = 0,
+    last_bit_draws: int = 0,
 ) -> list[RunResult]:
     """Every method on ``len(seeds) × len(levels)`` simulated logs, in parallel via joblib.
 
     Parameters
     ----------
+    range_noise, drop_fraction, clutter_fraction, degrade_seed
+        Every log is degraded so (:func:`fhslam.sim.degrade`; all zero: not at all).
+    last_bit_draws : int
+        Each log is also run with its odometry perturbed in the last bit
+        (:func:`fhslam.sim.perturb_odometry`, seeds ``1 .. last_bit_draws``): what the same
+        code does on other CPUs. A result that changes much under it is not robust.
     n_jobs : int
         joblib's worker count (-1: all cores). Use ``joblib.parallel_config(backend=...)``
         around the call to run on another backend (e.g. ``"dask"`` or ``"ray"``).
@@ -119,15 +171,37 @@ def slam_sweep(
     Returns
     -------
     list of RunResult
-        Ordered by level, seed, method.
+        Ordered by level, seed, odometry draw (``last_bit``), method.
+
+    Raises
+    ------
+    ValueError
+        If a method is unknown, ``last_bit_draws`` is not a whole number >= 0 or the
+        degradation is not one :func:`fhslam.sim.degrade` takes; before any run starts.
     """
     unknown = set(methods) - set(METHODS)
     if unknown:
         raise ValueError(f"unknown SLAM methods {sorted(unknown)}; choose from {list(METHODS)}")
-    jobs = [(lv, s) for lv in levels for s in seeds]
+    if isinstance(last_bit_draws, bool) or not (
+        isinstance(last_bit_draws, int | np.integer) and last_bit_draws >= 0
+    ):
+        raise ValueError(f"last_bit_draws must be a whole number >= 0, got {last_bit_draws!r}")
+    drop_fraction, clutter_fraction, degrade_seed, range_noise = check_degradation(
+        drop_fraction, clutter_fraction, degrade_seed, range_noise
+    )
+    changed = {
+        "range_noise": range_noise,
+        "drop_fraction": drop_fraction,
+        "clutter_fraction": clutter_fraction,
+        "degrade_seed": degrade_seed,
+    }
+    jobs = [(lv, s, b) for lv in levels for s in seeds for b in range(last_bit_draws + 1)]
     par = Parallel(n_jobs=n_jobs, return_as="generator")
     with _workers_deaf_to_ctrl_c():  # the call starts the worker processes
-        results = par(delayed(one_run)(world, lv, s, tuple(methods)) for lv, s in jobs)
+        results = par(
+            delayed(one_run)(world, lv, s, tuple(methods), **changed, last_bit=b)
+            for lv, s, b in jobs
+        )
     rows: list[RunResult] = []
     for batch in tqdm(
         results, total=len(jobs), desc="SLAM sweep", unit="log", disable=not progress
@@ -206,8 +280,21 @@ def format_summary(rows: Sequence[RunResult]) -> str:
     levels += sorted({k[0] for k in s} - set(levels))
     methods = [m for m in LABELS if any(k[1] == m for k in s)]
     seeds = len({r.seed for r in rows})
+    head = f"{len(rows)} runs: {seeds} seeds x {len(levels)} levels x {len(methods)} methods"
+    draws = len({r.last_bit for r in rows})
+    if draws > 1:
+        head += f" x {draws} odometry draws (last bit)"
+    changed = sorted(
+        {(r.range_noise, r.drop_fraction, r.clutter_fraction, r.degrade_seed) for r in rows}
+    )
+    for noise, drop, clutter, dseed in changed:
+        done = [f"{1000 * noise:g} mm range noise"] if noise else []
+        done += [f"{100 * drop:g} % of the scans dropped"] if drop else []
+        done += [f"{100 * clutter:g} % clutter"] if clutter else []
+        if done:
+            head += f"; logs with {', '.join(done)} (seed {dseed})"
     lines = [
-        f"{len(rows)} runs: {seeds} seeds x {len(levels)} levels x {len(methods)} methods",
+        head,
         f"{'level':7} {'method':26} {'ATE median':>11} {'ATE max':>9} {'map err med':>12} "
         f"{'ms/step':>8}",
     ]
@@ -255,19 +342,21 @@ def load_sweep(path: str | os.PathLike[str]) -> list[RunResult]:
         raise InputError(f"{p}: cannot read ({e})") from None
     reader = csv.reader(text.splitlines())
     header = next(reader, None)
-    if header is None or tuple(header) != FIELDS:
+    # files written before the sweep could degrade its logs have the first eight columns
+    names = tuple(header or ())
+    if names not in (FIELDS, FIELDS[:8]):
         raise InputError(f"{p}:1: not a sweep file (expected the header {','.join(FIELDS)})")
     types = [f.type for f in fields(RunResult)]
     rows = []
     for line, values in enumerate(reader, start=2):
         if not values:
             continue
-        if len(values) != len(FIELDS):
-            raise InputError(f"{p}:{line}: {len(values)} fields, expected {len(FIELDS)}")
+        if len(values) != len(names):
+            raise InputError(f"{p}:{line}: {len(values)} fields, expected {len(names)}")
         try:
             kw = {
                 name: (int(v) if t in ("int", int) else float(v) if t in ("float", float) else v)
-                for name, t, v in zip(FIELDS, types, values, strict=True)
+                for name, t, v in zip(names, types, values, strict=False)
             }
         except ValueError as e:
             raise InputError(f"{p}:{line}: not a number ({e})") from None

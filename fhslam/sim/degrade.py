@@ -53,6 +53,22 @@ def _check_fraction(name: str, value: float) -> float:
     return f
 
 
+def check_degradation(
+    drop_fraction: float = 0.0,
+    clutter_fraction: float = 0.0,
+    seed: int = 0,
+    range_noise: float = 0.0,
+) -> tuple[float, float, int, float]:
+    """:func:`degrade`'s arguments checked (and as floats and an int), so that a caller
+    about to start many runs can refuse bad ones first; raises as :func:`degrade` does."""
+    return (
+        _check_fraction("drop_fraction", drop_fraction),
+        _check_fraction("clutter_fraction", clutter_fraction),
+        _check_seed(seed),
+        _check_non_negative("range_noise", range_noise, " of metres"),
+    )
+
+
 def degrade(
     log: Log,
     drop_fraction: float = 0.0,
@@ -113,12 +129,11 @@ def degrade(
         If a fraction is outside [0, 1) or not a number, ``resolution`` or ``range_noise``
         is negative or not a finite number, or ``seed`` is not a whole number >= 0.
     """
-    drop = _check_fraction("drop_fraction", drop_fraction)
-    clutter = _check_fraction("clutter_fraction", clutter_fraction)
+    drop, clutter, seed, sigma = check_degradation(
+        drop_fraction, clutter_fraction, seed, range_noise
+    )
     if not (np.isfinite(resolution) and resolution >= 0):
         raise ValueError(f"resolution must be >= 0, got {resolution!r}")
-    sigma = _check_non_negative("range_noise", range_noise, " of metres")
-    seed = _check_seed(seed)
     # Three independent streams; the first two are what they were before range noise.
     drop_rng, clutter_rng, noise_rng = (
         np.random.default_rng(s) for s in np.random.SeedSequence(seed).spawn(3)

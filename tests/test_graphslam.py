@@ -613,11 +613,11 @@ def test_range_noise_changes_little(real_data, name):
     )
 
 
-@pytest.mark.parametrize(("name", "seed"), [("intel", 1), ("fr079", 2)])
+@pytest.mark.parametrize(("name", "seed"), [("intel", 1), ("fr079", 2), ("fr-clinic", 1)])
 def test_the_last_bit_changes_little(real_data, name, seed):
     """The odometry multiplied by (1 + 1e-15 epsilon), what another CPU may do (MIT CSAIL and
     ACES: their own tests). Measured: Intel 0.0143 m (seed 1), Freiburg 079 0.0304 m (seed
-    2); every scan 0.0143 and 0.0303 m."""
+    2), the hospital 0.1271 m (seeds 1 and 2); every scan 0.0143, 0.0303 and 0.127 m."""
     every_scan = REAL_LOGS[name][1]
     e = _relations_error(real_data, name, odometry_noise_seed=seed)
     assert e.trans_mean <= max(1.1 * every_scan, every_scan + 0.002), f"{e.trans_mean:.4f} m"

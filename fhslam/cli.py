@@ -543,6 +543,38 @@ WORLDS_HELP = "'paper', 'hall', 'corridor', 'ring', 'offices', 'random:SEED'"
 does not import the simulator."""
 
 
+def _degrade_arguments(g) -> None:
+    """``slam``'s and ``sweep``'s options for :func:`fhslam.sim.degrade`."""
+    g.add_argument(
+        "--range-noise",
+        type=_non_negative("metres"),
+        default=0.0,
+        metavar="M",
+        help="Gaussian noise of M metres (standard deviation) on every valid range",
+    )
+    g.add_argument(
+        "--drop-scans",
+        type=_fraction,
+        default=0.0,
+        metavar="F",
+        help="drop this share of the scans (never the first), as lost laser messages",
+    )
+    g.add_argument(
+        "--clutter",
+        type=_fraction,
+        default=0.0,
+        metavar="F",
+        help="this share of each scan's valid beams returns short, as from people or chairs",
+    )
+    g.add_argument(
+        "--degrade-seed",
+        type=_seed,
+        default=0,
+        metavar="N",
+        help="seed of the noise, dropped scans and clutter (default 0)",
+    )
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog="fhslam",
@@ -608,34 +640,7 @@ def build_parser() -> argparse.ArgumentParser:
         "degrade the log before the run (fhslam.sim.degrade, fhslam.sim.perturb_odometry); "
         "the trajectory's header names what was done",
     )
-    g.add_argument(
-        "--range-noise",
-        type=_non_negative("metres"),
-        default=0.0,
-        metavar="M",
-        help="Gaussian noise of M metres (standard deviation) on every valid range",
-    )
-    g.add_argument(
-        "--drop-scans",
-        type=_fraction,
-        default=0.0,
-        metavar="F",
-        help="drop this share of the scans (never the first), as lost laser messages",
-    )
-    g.add_argument(
-        "--clutter",
-        type=_fraction,
-        default=0.0,
-        metavar="F",
-        help="this share of each scan's valid beams returns short, as from people or chairs",
-    )
-    g.add_argument(
-        "--degrade-seed",
-        type=_seed,
-        default=0,
-        metavar="N",
-        help="seed of the noise, dropped scans and clutter (default 0)",
-    )
+    _degrade_arguments(g)
     g.add_argument(
         "--last-bit",
         type=_seed,
@@ -792,34 +797,7 @@ def build_parser() -> argparse.ArgumentParser:
         "degrade every simulated log before its runs, as `fhslam slam` does "
         "(fhslam.sim.degrade, fhslam.sim.perturb_odometry); the CSV file records it",
     )
-    g.add_argument(
-        "--range-noise",
-        type=_non_negative("metres"),
-        default=0.0,
-        metavar="M",
-        help="Gaussian noise of M metres (standard deviation) on every valid range",
-    )
-    g.add_argument(
-        "--drop-scans",
-        type=_fraction,
-        default=0.0,
-        metavar="F",
-        help="drop this share of the scans (never the first), as lost laser messages",
-    )
-    g.add_argument(
-        "--clutter",
-        type=_fraction,
-        default=0.0,
-        metavar="F",
-        help="this share of each scan's valid beams returns short, as from people or chairs",
-    )
-    g.add_argument(
-        "--degrade-seed",
-        type=_seed,
-        default=0,
-        metavar="N",
-        help="seed of the noise, dropped scans and clutter (default 0)",
-    )
+    _degrade_arguments(g)
     g.add_argument(
         "--last-bit-draws",
         type=_seed,

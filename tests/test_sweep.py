@@ -90,6 +90,8 @@ OLD = ",".join(FIELDS[:8])
             ":2: not a number",
         ),
         (OLD + "\nslow,low,0,0.1,0.2,0.3,1.0,5\n", ":2: unknown method 'slow'"),
+        (",".join(FIELDS) + "\nfht,low,0,0.1,0.2,0.3,1.0,5,0,1.5,0,0,0\n", ":2: not a degradation"),
+        (",".join(FIELDS) + "\nfht,low,0,0.1,0.2,0.3,1.0,5,0,0,0,0,-1\n", "last_bit must be >= 0"),
         (OLD + "\nfht,huge,0,0.1,0.2,0.3,1.0,5\n", ":2: unknown noise level"),
     ],
 )

@@ -364,7 +364,16 @@ def load_sweep(path: str | os.PathLike[str]) -> list[RunResult]:
             raise InputError(f"{p}:{line}: unknown method {kw['method']!r}")
         if kw["level"] not in noise_levels():
             raise InputError(f"{p}:{line}: unknown noise level {kw['level']!r}")
-        rows.append(RunResult(**kw))
+        r = RunResult(**kw)
+        try:
+            check_degradation(r.drop_fraction, r.clutter_fraction, r.degrade_seed, r.range_noise)
+            if r.last_bit < 0:
+                raise ValueError(f"last_bit must be >= 0, got {r.last_bit}")
+        except ValueError as e:
+            raise InputError(
+                f"{p}:{line}: not a degradation fhslam.sim.degrade makes ({e})"
+            ) from None
+        rows.append(r)
     if not rows:
         raise InputError(f"{p}: no runs in this sweep file")
     return rows

@@ -204,8 +204,10 @@ print(format_summary(sweep))
 # rmse in metres over the runs `r` of `rows` with `r.method == method` and `r.level == level`: the
 # "ATE median" and "ATE max" columns of the table above. `rows` is a list of
 # `fhslam.experiments.compare.RunResult`, like `sweep` (fields `method`, `level`, `seed`,
-# `ate_rmse`, `odometry_ate_rmse`, `map_error`, `ms_per_step`, `n_map_lines`). The median, not the
-# mean: one run gone wrong moves the mean, not the median. The check compares your function with
+# `ate_rmse`, `odometry_ate_rmse`, `map_error`, `ms_per_step`, `n_map_lines`, and what was done to
+# the log before the run: `range_noise`, `drop_fraction`, `clutter_fraction`, `degrade_seed`,
+# `last_bit`, all 0 in this sweep). The median, not the mean: one run gone wrong moves the
+# mean, not the median. The check compares your function with
 # `fhslam.experiments.compare.summary` on four small made-up lists (runs of several methods and
 # levels mixed, an even number of runs, a single run), then on every method and level of the
 # loaded sweep.

@@ -37,6 +37,7 @@ __all__ = [
     "match_clouds",
     "refine",
     "scan_normals",
+    "smooth_scan",
     "voxel_downsample",
     "voxel_index",
 ]
@@ -159,6 +160,57 @@ def _scan_normals_numpy(points, half_window=3, max_gap=0.1, max_gap_per_metre=0.
     ok &= mean - half <= 0.25**2 * (mean + half)  # spread across under 1/4 of along
     nrm = np.column_stack([np.cos(theta), np.sin(theta)])
     out[half_window : n - half_window][ok] = nrm[ok]
+    return out
+
+
+def smooth_scan(
+    points: ArrayLike,
+    normals: ArrayLike,
+    half_window: int = 3,
+    max_turn_deg: float = 10.0,
+    max_spread: float = 2.0,
+) -> NDArray[np.float64]:
+    """A scan's points (laser frame, beam order) with their range noise across the surface
+    averaged out: each point whose :func:`scan_normals` normal exists (``normals``, computed
+    with the same ``half_window``) is moved onto the total-least-squares line of its window
+    (the ``2 half_window + 1`` consecutive points through their mean, along that normal).
+
+    Only where the surface is straight over more than the window: the normals
+    ``half_window`` beams before and after must lie within ``max_turn_deg`` of the point's
+    own, so that corners (a window straddling two walls at an obtuse angle can still pass
+    :func:`scan_normals`' straightness test) keep their points; and the window's points
+    must lie within ``max_spread`` times the scan's median rms distance of a window to
+    its line (the range noise, as this scan shows it), so that a step or a recess smaller
+    than the window (a door frame) is not ironed out. Other points are returned as they
+    are. Along a wall the points stay where they were; what the window removes is
+    the noise that moves them off it (1 cm in the simulated laser), which a keyframe cloud
+    otherwise carries into every scan matched against it.
+    """
+    p = as_points(points, "points")
+    nrm = np.asarray(normals, dtype=float).reshape(-1, 2)
+    if len(nrm) != len(p):
+        raise ValueError(f"{len(nrm)} normals for {len(p)} points")
+    if half_window < 1:
+        raise ValueError(f"half_window must be >= 1, got {half_window}")
+    h, n = half_window, len(p)
+    out = p.copy()
+    if n < 2 * h + 1:
+        return out
+    inner = np.arange(h, n - h)
+    mean = np.lib.stride_tricks.sliding_window_view(p, 2 * h + 1, axis=0).mean(axis=2)
+    own, before, after = nrm[inner], nrm[inner - h], nrm[inner + h]
+    cos = np.cos(np.radians(max_turn_deg))
+    with np.errstate(invalid="ignore"):  # NaN normals compare False
+        ok = (np.abs((own * before).sum(1)) >= cos) & (np.abs((own * after).sum(1)) >= cos)
+    if not ok.any():
+        return out
+    window = np.lib.stride_tricks.sliding_window_view(p, 2 * h + 1, axis=0)  # (m, 2, w)
+    across = ((window - mean[:, :, None]) * np.nan_to_num(own)[:, :, None]).sum(axis=1)
+    rms = np.sqrt((across**2).mean(axis=1))
+    ok &= rms <= max_spread * np.median(rms[ok])
+    k = inner[ok]
+    off = ((p[k] - mean[ok]) * own[ok]).sum(1)
+    out[k] -= off[:, None] * own[ok]
     return out
 
 

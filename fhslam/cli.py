@@ -538,7 +538,7 @@ def _log_arguments(p: argparse.ArgumentParser) -> None:
     )
 
 
-WORLDS_HELP = "'paper', 'hall', 'corridor', 'ring', 'offices', 'random:SEED'"
+WORLDS_HELP = "'paper', 'hall', 'corridor', 'ring', 'offices', 'campus', 'random:SEED'"
 """The built-in worlds (:data:`fhslam.sim.world.BUILTIN_WORLDS`), named here so that the help
 does not import the simulator."""
 

@@ -15,6 +15,7 @@ from fhslam.sim import (
     WorldFormatError,
     add_range_noise,
     beam_angles,
+    campus_world,
     cast_rays,
     corridor_world,
     degrade,
@@ -246,6 +247,22 @@ def test_the_ring_is_a_corridor_round_a_block_with_alcoves():
     assert np.sum(np.isclose(lengths, 0.8)) == 2 * alcoves
     assert 24 <= alcoves <= 40  # 7-13 m apart on both sides of 150 m of corridor
     assert load_world("ring").walls.tolist() == w.walls.tolist()
+
+
+def test_the_campus_is_a_kilometre_of_corridors_driven_both_ways():
+    w = campus_world()
+    assert w.route_length == pytest.approx(1062.5)
+    assert route_clearance(w) == pytest.approx(1.25)  # the corridors' centre lines
+    lengths = np.hypot(w.walls[:, 2] - w.walls[:, 0], w.walls[:, 3] - w.walls[:, 1])
+    alcoves = np.sum(np.isclose(lengths, 1.0))
+    assert np.sum(np.isclose(lengths, 0.8)) == 2 * alcoves
+    assert 130 <= alcoves <= 200  # 7-13 m apart on both sides of about 1.2 km of wall
+    # the south corridor's west half is driven east first, then west (after 531 m), the
+    # middle corridor twice southward, the south corridor's east half twice eastward
+    r = w.route
+    assert r[0].tolist() == [1.25, 1.25] and r[5].tolist() == [1.25, 1.25]
+    assert r[3:5].tolist() == r[7:9].tolist() == [[100.0, 118.75], [100.0, 1.25]]
+    assert load_world("campus").walls.tolist() == w.walls.tolist()
 
 
 def test_the_offices_route_drives_its_corridor_both_ways():

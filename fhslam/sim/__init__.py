@@ -17,6 +17,7 @@ from fhslam.sim.truth import (
 from fhslam.sim.world import (
     World,
     WorldFormatError,
+    campus_world,
     corridor_world,
     hall_world,
     load_world,
@@ -38,6 +39,7 @@ __all__ = [
     "add_range_noise",
     "beam_angles",
     "beam_wall_points",
+    "campus_world",
     "cast_rays",
     "corridor_world",
     "degrade",

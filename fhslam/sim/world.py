@@ -15,8 +15,9 @@ four is read as a misspelling: the world is used without it and an
 Built-in worlds: ``"paper"`` (:func:`paper_world`, the paper's 18.7 x 14.0 m office),
 ``"random:SEED"`` (:func:`random_world`, held-out worlds nothing was tuned on), and two small
 worlds with walls through the origin, ``"hall"`` (:func:`hall_world`) and ``"corridor"``
-(:func:`corridor_world`), a 150 m corridor ring, ``"ring"`` (:func:`ring_world`), and an
-office floor whose route drives its corridor both ways, ``"offices"`` (:func:`offices_world`).
+(:func:`corridor_world`), a 150 m corridor ring, ``"ring"`` (:func:`ring_world`), an
+office floor whose route drives its corridor both ways, ``"offices"`` (:func:`offices_world`),
+and a kilometre of corridors round two blocks, ``"campus"`` (:func:`campus_world`).
 :func:`transform_world` moves a world rigidly (to check that a
 method does not depend on where the world frame lies).
 """
@@ -38,7 +39,7 @@ from fhslam.geometry import compose, segment_distances, transform_points, wrap_a
 from fhslam.io.files import input_path, reading
 from fhslam.io.mapfile import MAX_COORDINATE
 
-BUILTIN_WORLDS = ("paper", "hall", "corridor", "ring", "offices", "random:SEED")
+BUILTIN_WORLDS = ("paper", "hall", "corridor", "ring", "offices", "campus", "random:SEED")
 
 WORLD_KEYS = ("name", "walls", "route", "start")
 """The keys of a world JSON object; any other is warned about and ignored."""
@@ -483,6 +484,50 @@ def ring_world() -> World:
     )  # fmt: skip
 
 
+def campus_world() -> World:
+    """Corridors 2.5 m wide round two 97.5 x 115 m blocks side by side, with a corridor
+    between them: a 200 x 120 m floor whose route runs 1,062 m (origin: the south-west
+    corner), the scale of the long indoor logs (MIT's Killian Court, whose relations span
+    2.1 hours).
+
+    Built as the ``ring`` is (both sides of every corridor with alcoves 1 m wide and 0.8 m
+    deep, 7-13 m apart). The route starts at (1.25, 1.25) heading east (0.02 rad), goes
+    round the east block and down the middle corridor (531 m), back west along the south
+    corridor it started in, now facing the other way; then round the west block and down
+    the middle corridor again, and east along the south corridor as at the start. Coming
+    down the middle corridor onto the south one, the robot looks along a corridor it drove
+    430 m earlier facing the other way: the two views overlap little, and most where the
+    corridors cross (README, *Not solved: long corridors*).
+    """
+    w, h, c = 200.0, 120.0, 2.5
+    m, x = c / 2, w / 2
+
+    def block(x0, y0, x1, y1):
+        return [
+            _alcoved((x0, y0), (x0, y1), (1, 0)),
+            _alcoved((x0, y1), (x1, y1), (0, -1)),
+            _alcoved((x1, y1), (x1, y0), (-1, 0)),
+            _alcoved((x1, y0), (x0, y0), (0, 1)),
+        ]
+
+    walls = [
+        _alcoved((0, 0), (w, 0), (0, -1)),
+        _alcoved((w, 0), (w, h), (1, 0)),
+        _alcoved((w, h), (0, h), (0, 1)),
+        _alcoved((0, h), (0, 0), (-1, 0)),
+        *block(c, c, x - m, h - c),
+        *block(x + m, c, w - c, h - c),
+    ]
+    route = [
+        (m, m), (w - m, m), (w - m, h - m), (x, h - m), (x, m),  # round the east block
+        (m, m), (m, h - m), (x, h - m), (x, m), (w - m, m),  # the west block, then east
+    ]  # fmt: skip
+    return World(
+        name="campus", walls=np.vstack(walls), route=np.array(route, dtype=float),
+        start=np.array([m, m, 0.02]),
+    )  # fmt: skip
+
+
 def offices_world() -> World:
     """A 20 x 12 m office floor (origin: the south-west corner): an east-west corridor 2 m
     wide (y 5-7 m) between four rooms 5 m wide on each side, doors 1 m wide, three boxes
@@ -642,6 +687,7 @@ def load_world(name_or_path: str | PathLike[str]) -> World:
             "corridor": corridor_world,
             "ring": ring_world,
             "offices": offices_world,
+            "campus": campus_world,
         }
         if text in builtin:
             return builtin[text]()

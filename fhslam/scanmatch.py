@@ -197,14 +197,14 @@ def smooth_scan(
     if n < 2 * h + 1:
         return out
     inner = np.arange(h, n - h)
-    mean = np.lib.stride_tricks.sliding_window_view(p, 2 * h + 1, axis=0).mean(axis=2)
+    window = np.lib.stride_tricks.sliding_window_view(p, 2 * h + 1, axis=0)  # (m, 2, w)
+    mean = window.mean(axis=2)
     own, before, after = nrm[inner], nrm[inner - h], nrm[inner + h]
     cos = np.cos(np.radians(max_turn_deg))
     with np.errstate(invalid="ignore"):  # NaN normals compare False
         ok = (np.abs((own * before).sum(1)) >= cos) & (np.abs((own * after).sum(1)) >= cos)
     if not ok.any():
         return out
-    window = np.lib.stride_tricks.sliding_window_view(p, 2 * h + 1, axis=0)  # (m, 2, w)
     across = ((window - mean[:, :, None]) * np.nan_to_num(own)[:, :, None]).sum(axis=1)
     rms = np.sqrt((across**2).mean(axis=1))
     ok &= rms <= max_spread * np.median(rms[ok])

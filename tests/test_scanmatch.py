@@ -424,6 +424,7 @@ def test_smoothing_commutes_with_a_rigid_motion_and_refuses_bad_input():
     assert np.abs(a - b).max() <= 1e-9
     short = noisy[:6]
     assert np.array_equal(smooth_scan(short, scan_normals(short)), short)
+    assert np.array_equal(smooth_scan(noisy, np.full_like(noisy, np.nan)), noisy)  # no normals
     with pytest.raises(ValueError, match="3 normals for 120 points"):
         smooth_scan(noisy, np.zeros((3, 2)))
     with pytest.raises(ValueError, match="half_window must be >= 1"):

@@ -120,13 +120,13 @@ class GraphSlamParams:
         keyframe's cloud, so that the range noise across a wall is averaged out of the map
         the scans are tracked against (not out of the scans themselves). Off by default
         (stop 34): it cuts the tracker's heading drift along straight corridors severalfold
-        (96 m of corridor with perfect odometry and the simulator's 1 cm of range noise,
-        seeds 0-3: 2.3-2.8 degrees and 1.9-2.4 m sideways at its end without, 0.3-0.8
-        degrees and 0.3-0.9 m with it; the ``ring``'s first straight 0.8-1.25 degrees,
-        0.0-0.4 with it), keeps four of the five shared logs within 1.5 % and the 120
-        simulated runs of the README's yardstick at a mean of 1.12 cm (1.17 without), but
-        the Freiburg hospital's return fails in 7 of 33 perturbed runs instead of 3
-        (README, *Not solved: long corridors*).
+        (96 m of the ``campus``'s corridor with perfect odometry and the simulator's 1 cm of
+        range noise, seeds 0-3: 2.3-2.8 degrees and 1.9-2.4 m sideways at its end without,
+        0.5-0.86 degrees and 0.45-0.6 m with it; the ``ring``'s first straight 0.8-1.25
+        degrees, -0.03 to 0.48 with it), keeps the five shared logs within 1.5 % and the 120
+        simulated runs of the README's yardstick at a mean of 1.16 cm (1.17 without), but
+        the Freiburg hospital's return fails in 4 of 33 perturbed runs (3 without): not
+        better everywhere yet (README, *Not solved: long corridors*).
     submap_keyframes : int
         Keyframes in the local map a scan is tracked against.
     max_doubtful : int

@@ -657,11 +657,14 @@ def test_smoothed_keyframe_clouds_stop_the_heading_drift_along_a_corridor():
     # (``smooth_clouds``, off by default: README, *Not solved: long corridors*) 0.44 and
     # -0.03 degrees.
     ring = load_world("ring")
+    logs = {
+        seed: simulate(ring, seed=seed, odometry=OdometryNoise.none(), max_scans=480)
+        for seed in (0, 1)
+    }
     off = {}
     for smooth in (False, True):
         params = GraphSlamParams(smooth_clouds=smooth, loop_candidates=0, global_every=0)
-        for seed in (0, 1):
-            log = simulate(ring, seed=seed, odometry=OdometryNoise.none(), max_scans=480)
+        for seed, log in logs.items():
             end = run_slam(log, params=params).poses[-1, 2] - log.truth[-1, 2]
             off[smooth, seed] = abs(np.degrees(wrap_angle(end)))
     assert min(off[False, 0], off[False, 1]) >= 0.7

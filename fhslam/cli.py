@@ -317,6 +317,12 @@ def _slam(args: argparse.Namespace) -> None:
             f"--graph: only with --method graph; the {args.method} method keeps no keyframe "
             "graph (nothing was written)"
         )
+    if args.set and args.method != "graph":
+        raise InputError(
+            f"--set: only with --method graph; set the {args.method} method's parameters in "
+            "Python (nothing was written)"
+        )
+    params = _graph_params(args.set) if args.set else None
     check_outputs(
         {
             "--trajectory": args.trajectory,
@@ -341,9 +347,9 @@ def _slam(args: argparse.Namespace) -> None:
         progress = not args.quiet and len(log) > 200
         graph = None
         if args.method != "graph" or (args.graph is None and args.plot is None):
-            result = run_slam(log, args.method, progress=progress)
+            result = run_slam(log, args.method, params, progress=progress)
         else:
-            backend = make_backend(args.method)
+            backend = make_backend(args.method, params)
             result = run_backend(backend, log, progress, desc=f"{args.method} {log.name}")
             graph = keyframe_graph(backend, log)
         # Everything is computed before anything is written, and the files are renamed into
@@ -353,7 +359,9 @@ def _slam(args: argparse.Namespace) -> None:
                 args.trajectory,
                 result.timestamps,
                 result.poses,
-                header=f"fhslam slam --method {args.method} {args.log}"
+                header=f"fhslam slam --method {args.method} "
+                + "".join(f"--set {x} " for x in args.set)
+                + f"{args.log}"
                 + (f" ({degraded})" if degraded else "")
                 + ": timestamp x y theta",
             )
@@ -371,6 +379,47 @@ def _slam(args: argparse.Namespace) -> None:
                 _write_plot(args.plot, log, result, args.method, graph)
                 wrote.append(f"a picture of the run to {args.plot}")
         print("wrote " + ", ".join(wrote[:-1]) + (" and " if len(wrote) > 1 else "") + wrote[-1])
+
+
+def _graph_params(pairs: list[str]):
+    """The :class:`~fhslam.slam.GraphSlamParams` of ``slam --set NAME=VALUE`` options: the
+    defaults, with each named number or switch (a field of type bool, int or float) set."""
+    import math
+    from dataclasses import fields
+
+    from fhslam.errors import InputError
+    from fhslam.slam import GraphSlamParams
+
+    kinds = {f.name: str(f.type) for f in fields(GraphSlamParams)}
+    settable = sorted(n for n, k in kinds.items() if k in ("bool", "int", "float"))
+    values: dict[str, object] = {}
+    for pair in pairs:
+        name, sep, text = (x.strip() for x in pair.partition("="))
+        if not sep or not name or not text:
+            raise InputError(f"--set {pair!r}: expected NAME=VALUE, e.g. loop_target_keyframes=6")
+        kind = kinds.get(name)
+        if kind not in ("bool", "int", "float"):
+            raise InputError(
+                f"--set {pair!r}: {name!r} is not a number or switch of GraphSlamParams; "
+                f"one of: {', '.join(settable)}"
+            )
+        try:
+            if kind == "bool":
+                if text.lower() not in ("true", "false", "1", "0", "yes", "no", "on", "off"):
+                    raise ValueError(text)
+                value: object = text.lower() in ("true", "1", "yes", "on")
+            else:
+                value = int(text) if kind == "int" else float(text)
+                if not math.isfinite(value):
+                    raise ValueError(text)
+        except ValueError:
+            wanted = {"bool": "true or false", "int": "an integer", "float": "a finite number"}
+            raise InputError(f"--set {pair!r}: {name} takes {wanted[kind]}, got {text!r}") from None
+        values[name] = value
+    try:
+        return GraphSlamParams(**values)
+    except ValueError as e:
+        raise InputError(f"--set: {e}") from None
 
 
 def _degraded(log, args: argparse.Namespace):
@@ -632,6 +681,15 @@ def build_parser() -> argparse.ArgumentParser:
         type=Path,
         help="output PNG: the map, the trajectory and the odometry (the truth where the log "
         "has it; a graph run's loop closures)",
+    )
+    p.add_argument(
+        "--set",
+        action="append",
+        default=[],
+        metavar="NAME=VALUE",
+        help="--method graph: set a number or switch of fhslam.slam.GraphSlamParams (repeat "
+        "for more), e.g. --set loop_target_keyframes=6 --set smooth_clouds=true; the "
+        "trajectory's header records it",
     )
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.add_argument("--profile", action="store_true", help=PROFILE_HELP)

@@ -901,6 +901,58 @@ def test_slam_robustness_options_run_the_degraded_log(short_clf, tmp_path, capsy
     np.testing.assert_allclose(poses, expected.poses, atol=1e-9)  # the file's 9+ digits
 
 
+def test_slam_set_runs_the_graph_method_with_those_parameters(short_clf, tmp_path):
+    """``--set NAME=VALUE`` sets a number or switch of ``GraphSlamParams``: the run is the
+    Python run with those parameters, and the trajectory's header records them."""
+    from fhslam.pipeline import run_slam
+    from fhslam.slam import GraphSlamParams
+
+    out = tmp_path / "t.txt"
+    sets = ["--set", "smooth_clouds=true", "--set", "loop_target_keyframes = 6"]
+    assert main(["slam", str(short_clf), "--trajectory", str(out), "--quiet", *sets]) == 0
+    header = out.read_text().splitlines()[0]
+    assert "--set smooth_clouds=true --set loop_target_keyframes = 6" in header
+    log = read_carmen(short_clf)
+    expected = run_slam(log, params=GraphSlamParams(smooth_clouds=True, loop_target_keyframes=6))
+    t, poses = read_trajectory(out)
+    np.testing.assert_array_equal(t, expected.timestamps)
+    np.testing.assert_allclose(poses, expected.poses, atol=1e-9)  # the file's 9+ digits
+    default = run_slam(log).poses
+    assert np.abs(default - expected.poses).max() > 1e-6  # the smoothing changed the run
+
+
+@pytest.mark.parametrize(
+    ("setting", "message"),
+    [
+        ("foo=1", "'foo' is not a number or switch of GraphSlamParams; one of: cloud_max_range"),
+        ("tracker=1", "'tracker' is not a number or switch"),
+        ("odometry_sigma=0.1", "'odometry_sigma' is not a number or switch"),
+        ("loop_target_keyframes=1.5", "loop_target_keyframes takes an integer, got '1.5'"),
+        ("smooth_clouds=maybe", "smooth_clouds takes true or false, got 'maybe'"),
+        ("loop_min_score=nan", "loop_min_score takes a finite number, got 'nan'"),
+        ("loop_min_score=1.5", r"--set: loop_min_score must be in [0, 1], got 1.5"),
+        ("loop_target_keyframes=-1", "loop_target_keyframes >= 0"),
+        ("loop_target_keyframes", "expected NAME=VALUE"),
+        ("=6", "expected NAME=VALUE"),
+    ],
+)
+def test_slam_bad_set_is_named_and_writes_nothing(short_clf, tmp_path, setting, message):
+    r = run("slam", str(short_clf), "--trajectory", str(tmp_path / "t.txt"), "--set", setting)
+    assert r.returncode == 2 and r.stdout == "" and "Traceback" not in r.stderr
+    assert r.stderr.startswith("fhslam: error: --set") and message in r.stderr
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_slam_set_is_refused_for_other_methods(short_clf, tmp_path):
+    r = run("slam", str(short_clf), "--method", "fht", "--trajectory", str(tmp_path / "t.txt"),
+            "--set", "smooth_clouds=true")  # fmt: skip
+    assert r.returncode == 2 and r.stderr == (
+        "fhslam: error: --set: only with --method graph; set the fht method's parameters in "
+        "Python (nothing was written)\n"
+    )
+    assert list(tmp_path.iterdir()) == []
+
+
 @pytest.mark.parametrize(
     ("option", "value"),
     [

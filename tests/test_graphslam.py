@@ -68,15 +68,22 @@ def test_a_closure_that_moves_its_keyframe_far_waits_for_an_independent_one():
 
 
 def test_closures_confirm_each_other_only_when_they_share_no_keyframe():
-    """Independent: the queries (keyframes i-2..i) apart, and the targets (candidate j and
-    three on either side) too."""
-    slam = GraphFastHoughSLAM()  # loop_min_gap 20
+    """A target is candidate j and ``loop_target_keyframes`` (3) keyframes on either side,
+    none within ``loop_min_gap`` (20) of the query. Independent: the queries (keyframes
+    i-2..i) apart, and the targets' cores (j-3..j+3, the whole target by default) too."""
+    slam = GraphFastHoughSLAM()
     assert slam._target(50, 100) == range(47, 54)
     assert slam._target(2, 100) == range(0, 6) and slam._target(79, 100) == range(76, 81)
-    assert slam._independent((50, 97), (57, 100))
-    assert not slam._independent((50, 98), (57, 100))  # keyframe 98 in both queries
-    assert not slam._independent((51, 97), (57, 100))  # keyframe 54 in both targets
-    assert not slam._independent((0, 97), (0, 100)) and not slam._independent((1, 97), (0, 100))
+    wide = GraphFastHoughSLAM(GraphSlamParams(loop_target_keyframes=6))
+    assert wide._target(50, 100) == range(44, 57) and wide._target(79, 100) == range(73, 81)
+    assert GraphFastHoughSLAM(GraphSlamParams(loop_target_keyframes=0))._target(50, 100) == (
+        range(50, 51)
+    )
+    for s in (slam, wide):  # the same cores whatever the targets' width
+        assert s._independent((50, 97), (57, 100))
+        assert not s._independent((50, 98), (57, 100))  # keyframe 98 in both queries
+        assert not s._independent((51, 97), (57, 100))  # keyframe 54 in both cores
+        assert not s._independent((0, 97), (0, 100)) and not s._independent((1, 97), (0, 100))
 
 
 def test_a_corridor_ring_comes_back_to_its_start_without_a_false_closure():
@@ -413,6 +420,7 @@ def test_without_loop_closures_no_loop_edges(three_laps):
         ("cloud_voxel", -1.0, "cloud_voxel must be > 0"),
         ("loop_min_score", 1.5, r"loop_min_score must be in \[0, 1\]"),
         ("submap_keyframes", 0, "submap_keyframes and loop_min_gap must be >= 1"),
+        ("loop_target_keyframes", -1, "loop_candidates and loop_target_keyframes >= 0"),
         ("loop_optimize_chi2", -1.0, "loop_optimize_chi2 must be >= 0"),
         ("loop_consistency", 0.0, "loop_consistency must be > 0"),
         ("loop_confirm_window", 0, "loop_confirm_window must be >= 1"),

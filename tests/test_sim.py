@@ -176,6 +176,16 @@ def test_simulate_max_scans():
         simulate(paper_world(), max_scans=0)
 
 
+def test_a_run_cut_short_shares_the_path_and_ranges_but_not_the_odometry_errors():
+    """Documented in ``simulate``: the odometry's errors are drawn for the run as a whole."""
+    whole = simulate(paper_world(), seed=0)
+    cut = simulate(paper_world(), seed=0, max_scans=50)
+    assert np.array_equal(cut.truth, whole.truth[:50])
+    assert np.array_equal(cut.ranges, whole.ranges[:50], equal_nan=True)
+    assert np.array_equal(cut.odometry[0], whole.odometry[0])
+    assert np.abs(cut.odometry - whole.odometry[:50]).max() > 1e-4  # another draw
+
+
 def test_simulate_custom_laser():
     laser = LaserParams(n_beams=361, fov_deg=270.0, max_range=5.0)
     log = simulate(paper_world(), laser=laser, max_scans=5)

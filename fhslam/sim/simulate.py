@@ -264,7 +264,11 @@ def simulate(
     odometry : OdometryNoise
     motion : MotionParams
     max_scans : int, optional
-        Stop after this many scans (default: at the end of the route).
+        Stop after this many scans (default: at the end of the route). The path and the
+        ranges are the first ``max_scans`` of the whole route's, but the odometry's random
+        errors are drawn for the run as a whole, so they are not: a run cut short is another
+        draw of the odometry, not a prefix of the full run's (the ``campus``'s first 8,000
+        scans: up to 1 m apart; ``tests/test_sim.py``).
     laps : int
         Drive a closed route (last waypoint equal to the first, as in every
         :func:`~fhslam.sim.random_world`) this many times in a row, for longer runs with

@@ -390,7 +390,7 @@ def _graph_params(pairs: list[str]):
     from fhslam.errors import InputError
     from fhslam.slam import GraphSlamParams
 
-    kinds = {f.name: str(f.type) for f in fields(GraphSlamParams)}
+    kinds = {f.name: getattr(f.type, "__name__", str(f.type)) for f in fields(GraphSlamParams)}
     settable = sorted(n for n, k in kinds.items() if k in ("bool", "int", "float"))
     values: dict[str, object] = {}
     for pair in pairs:

@@ -969,22 +969,22 @@ class GraphFastHoughSLAM:
         self._loops.append(LoopClosure(j, i, z, score, e))
         return e
 
-    def _target(self, j: int, i: int) -> range:
+    def _target(self, j: int, i: int, half: int | None = None) -> range:
         """The keyframes of candidate ``j``'s target for keyframe ``i``'s query: ``j`` and
-        ``loop_target_keyframes`` on either side, none within ``loop_min_gap`` of ``i``."""
-        k, p = self.params.loop_target_keyframes, self.params
+        ``half`` (default ``loop_target_keyframes``) on either side, none within
+        ``loop_min_gap`` of ``i``."""
+        p = self.params
+        k = p.loop_target_keyframes if half is None else half
         return range(max(0, j - k), min(j + k + 1, i - p.loop_min_gap + 1))
 
     def _independent(self, g, h) -> bool:
         """Whether held closures ``g`` and ``h`` share no keyframe in their queries
-        (keyframes ``i - 2 .. i``) nor in the cores of their targets (``j`` and three
-        keyframes on either side, none within ``loop_min_gap`` of ``i``). Not the whole
-        targets: with ``loop_target_keyframes`` 10, two queries ``loop_confirm_window``
-        keyframes apart could never confirm each other (the ``campus``'s closures were all
-        held, none confirmed)."""
-        gap = self.params.loop_min_gap
-        a = range(max(0, g[0] - 3), min(g[0] + 4, g[1] - gap + 1))
-        b = range(max(0, h[0] - 3), min(h[0] + 4, h[1] - gap + 1))
+        (keyframes ``i - 2 .. i``) nor in the cores of their targets (:meth:`_target` with
+        three keyframes on either side). Not the whole targets: with
+        ``loop_target_keyframes`` 10, two queries ``loop_confirm_window`` keyframes apart
+        could never confirm each other (the ``campus``'s closures were all held, none
+        confirmed)."""
+        a, b = self._target(g[0], g[1], 3), self._target(h[0], h[1], 3)
         return abs(g[1] - h[1]) >= 3 and max(a.start, b.start) >= min(a.stop, b.stop)
 
     def _agree(self, g, h, poses) -> bool:

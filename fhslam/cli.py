@@ -592,8 +592,9 @@ WORLDS_HELP = "'paper', 'hall', 'corridor', 'ring', 'offices', 'campus', 'random
 does not import the simulator."""
 
 
-def _degrade_arguments(g) -> None:
-    """``slam``'s and ``sweep``'s options for :func:`fhslam.sim.degrade`."""
+def _degrade_arguments(g, seed_default: int | None = 0) -> None:
+    """``slam``'s and ``sweep``'s options for :func:`fhslam.sim.degrade` (``sweep`` tells
+    an unset ``--degrade-seed``, None, from 0)."""
     g.add_argument(
         "--range-noise",
         type=_non_negative("metres"),
@@ -618,7 +619,7 @@ def _degrade_arguments(g) -> None:
     g.add_argument(
         "--degrade-seed",
         type=_seed,
-        default=0,
+        default=seed_default,
         metavar="N",
         help="seed of the noise, dropped scans and clutter (default 0)",
     )
@@ -825,27 +826,54 @@ def build_parser() -> argparse.ArgumentParser:
 
     p = sub.add_parser(
         "sweep",
-        help="every SLAM method on seeds x odometry-noise levels of a simulated world",
+        help="every SLAM method on seeds x odometry-noise levels of a simulated world, or on "
+        "degraded copies of a real log",
         description="Simulate WORLD with each seed and odometry-noise level (low, medium, "
         "high) and run every SLAM method on each log, in parallel; print the median ATE, map "
         "error and time per level and method. With --out, write every run as CSV: notebook "
-        "07 shows the committed notebooks/results/sweep_paper.csv.",
+        "07 shows the committed notebooks/results/sweep_paper.csv. With --log, run SLAM "
+        "(default: the graph method) on a real log as read and on copies degraded with seeds "
+        "0..N-1 (--range-noise, --drop-scans, --clutter; or --last-bit-draws), each measured "
+        "against the log's benchmark relations, and count the runs whose relation error "
+        "moved by more than 25 %% or 1 cm (whichever is larger) from the run on the log as "
+        "read: issue 10's robustness bound.",
     )
-    p.add_argument("--world", default="paper", help="world to simulate (default paper)")
-    p.add_argument("--seeds", type=int, default=20, help="seeds 0..N-1 per level (default 20)")
+    p.add_argument("--world", help="world to simulate (default paper)")
+    p.add_argument(
+        "--log",
+        help="a real laser log (CARMEN file, ROS bag or dataset name: intel, aces, ...) "
+        "instead of a simulated world",
+    )
+    p.add_argument(
+        "--relations",
+        help="--log: its benchmark relations file, or a dataset name (default: the dataset's "
+        "own when --log is a dataset name)",
+    )
+    p.add_argument(
+        "--seeds",
+        type=int,
+        default=20,
+        help="seeds 0..N-1 per level; with --log, the degradation's seeds (default 20)",
+    )
     p.add_argument(
         "--levels",
         nargs="+",
         choices=("low", "medium", "high"),
-        default=["low", "medium", "high"],
         help="odometry-noise levels (default all three)",
     )
     p.add_argument(
         "--methods",
         nargs="+",
         choices=SLAM_METHODS,
-        default=list(SLAM_METHODS),
-        help="SLAM methods (default all)",
+        help="SLAM methods (default all; with --log, graph)",
+    )
+    p.add_argument(
+        "--set",
+        action="append",
+        default=[],
+        metavar="NAME=VALUE",
+        help="set a number or switch of fhslam.slam.GraphSlamParams for the graph method's "
+        "runs, as `fhslam slam --set` does (repeat for more)",
     )
     p.add_argument("--jobs", type=int, default=-1, help="worker processes (default: all cores)")
     p.add_argument("--out", type=Path, help="write every run to this CSV file")
@@ -855,7 +883,7 @@ def build_parser() -> argparse.ArgumentParser:
         "degrade every simulated log before its runs, as `fhslam slam` does "
         "(fhslam.sim.degrade, fhslam.sim.perturb_odometry); the CSV file records it",
     )
-    _degrade_arguments(g)
+    _degrade_arguments(g, seed_default=None)
     g.add_argument(
         "--last-bit-draws",
         type=_seed,
@@ -941,28 +969,78 @@ def _sweep(args: argparse.Namespace) -> None:
         raise InputError(f"--last-bit-draws must be at most 100, got {args.last_bit_draws}")
     if args.jobs == 0:
         raise InputError("--jobs must not be 0 (-1: all cores)")
-    world = load_world(args.world)  # a bad world is an error before any worker starts
-    builtin = args.world in BUILTIN_WORLDS or args.world.startswith("random:")
-    check_scan_limit(world, source=None if builtin else args.world)
+    methods = args.methods or (["graph"] if args.log is not None else list(SLAM_METHODS))
+    if args.set and "graph" not in methods:
+        raise InputError("--set: only with the graph method among --methods")
+    params = _graph_params(args.set) if args.set else None
+    if args.log is not None:
+        _log_sweep(args, methods, params)
+        return
+    if args.relations is not None:
+        raise InputError("--relations: only with --log")
+    world_name = "paper" if args.world is None else args.world
+    world = load_world(world_name)  # a bad world is an error before any worker starts
+    builtin = world_name in BUILTIN_WORLDS or world_name.startswith("random:")
+    check_scan_limit(world, source=None if builtin else world_name)
     # and an output that cannot be written (a directory, no such folder, a read-only one),
     # before the hours of work
-    check_outputs({"--out": args.out}, {"the world file": None if builtin else args.world})
+    check_outputs({"--out": args.out}, {"the world file": None if builtin else world_name})
     rows = compare.slam_sweep(
-        world=args.world,
+        world=world_name,
         seeds=range(args.seeds),
-        levels=args.levels,
-        methods=args.methods,
+        levels=args.levels or ["low", "medium", "high"],
+        methods=methods,
         n_jobs=args.jobs,
         progress=not args.quiet,
         range_noise=args.range_noise,
         drop_fraction=args.drop_scans,
         clutter_fraction=args.clutter,
-        degrade_seed=args.degrade_seed,
+        degrade_seed=0 if args.degrade_seed is None else args.degrade_seed,
         last_bit_draws=args.last_bit_draws,
+        params=params,
     )
     if args.out is not None:
         compare.save_sweep(rows, args.out)
     print(compare.format_summary(rows))
+
+
+def _log_sweep(args: argparse.Namespace, methods: list[str], params) -> None:
+    """``fhslam sweep --log``: :func:`fhslam.experiments.robustness.log_sweep`, printed."""
+    from fhslam.errors import InputError
+    from fhslam.experiments import robustness
+    from fhslam.io.files import check_outputs
+
+    given = [
+        opt
+        for opt, value in (
+            ("--world", args.world),
+            ("--levels", args.levels),
+            ("--degrade-seed", args.degrade_seed),
+        )
+        if value is not None
+    ]
+    if given:
+        raise InputError(
+            f"{', '.join(given)}: not with --log (its own odometry; --seeds N draws the "
+            "degradation with seeds 0..N-1)"
+        )
+    check_outputs({"--out": args.out}, {"--log": args.log, "--relations": args.relations})
+    rows = robustness.log_sweep(
+        args.log,
+        args.relations,
+        seeds=range(args.seeds),
+        range_noise=args.range_noise,
+        drop_fraction=args.drop_scans,
+        clutter_fraction=args.clutter,
+        last_bit_draws=args.last_bit_draws,
+        methods=methods,
+        params=params,
+        n_jobs=args.jobs,
+        progress=not args.quiet,
+    )
+    if args.out is not None:
+        robustness.save_log_sweep(rows, args.out)
+    print(robustness.format_log_sweep(rows))
 
 
 def _student_copy(args: argparse.Namespace) -> None:

@@ -95,8 +95,10 @@ def one_run(
     clutter_fraction: float = 0.0,
     degrade_seed: int = 0,
     last_bit: int = 0,
+    params: object | None = None,
 ) -> list[RunResult]:
-    """Simulate ``world`` with noise ``level`` and ``seed``; run every method on that log.
+    """Simulate ``world`` with noise ``level`` and ``seed``; run every method on that log
+    (the ``graph`` method with ``params``, default its defaults).
 
     The log is first degraded (:func:`fhslam.sim.degrade` with ``range_noise``,
     ``drop_fraction``, ``clutter_fraction`` and ``degrade_seed``) if any of those is not
@@ -121,7 +123,7 @@ def one_run(
     out = []
     for m in methods:
         t0 = time.perf_counter()
-        r = run_slam(log, m)
+        r = run_slam(log, m, params if m == "graph" else None)
         ms = 1e3 * (time.perf_counter() - t0) / len(log)
         out.append(
             RunResult(
@@ -153,6 +155,7 @@ def slam_sweep(
     clutter_fraction: float = 0.0,
     degrade_seed: int = 0,
     last_bit_draws: int = 0,
+    params: object | None = None,
 ) -> list[RunResult]:
     """Every method on ``len(seeds) × len(levels)`` simulated logs, in parallel via joblib.
 
@@ -164,6 +167,8 @@ def slam_sweep(
         Each log is also run with its odometry perturbed in the last bit
         (:func:`fhslam.sim.perturb_odometry`, seeds ``1 .. last_bit_draws``): what the same
         code does on other CPUs. A result that changes much under it is not robust.
+    params : GraphSlamParams, optional
+        The ``graph`` method's parameters (default: its defaults).
     n_jobs : int
         joblib's worker count (-1: all cores). Use ``joblib.parallel_config(backend=...)``
         around the call to run on another backend (e.g. ``"dask"`` or ``"ray"``).
@@ -182,6 +187,8 @@ def slam_sweep(
     unknown = set(methods) - set(METHODS)
     if unknown:
         raise ValueError(f"unknown SLAM methods {sorted(unknown)}; choose from {list(METHODS)}")
+    if params is not None and "graph" not in methods:
+        raise ValueError("params apply to the graph method only, which is not among the methods")
     if isinstance(last_bit_draws, bool) or not (
         isinstance(last_bit_draws, int | np.integer) and last_bit_draws >= 0
     ):
@@ -199,7 +206,7 @@ def slam_sweep(
     par = Parallel(n_jobs=n_jobs, return_as="generator")
     with _workers_deaf_to_ctrl_c():  # the call starts the worker processes
         results = par(
-            delayed(one_run)(world, lv, s, tuple(methods), **changed, last_bit=b)
+            delayed(one_run)(world, lv, s, tuple(methods), **changed, last_bit=b, params=params)
             for lv, s, b in jobs
         )
     rows: list[RunResult] = []

@@ -34,11 +34,10 @@ from fhslam.sim.degrade import check_degradation
 __all__ = ["LOG_FIELDS", "LogRun", "beyond", "format_log_sweep", "log_sweep", "save_log_sweep"]
 
 RELATIVE_BOUND = 0.25
-"""Issue 10: a degraded run may change the relation error by this share of the unperturbed
-run's ...
-
-... or by :data:`ABSOLUTE_BOUND` metres, whichever is larger."""
+"""Issue 10: a degraded run may change the relation error by this share of the run's on the
+log as read, or by :data:`ABSOLUTE_BOUND`, whichever is larger."""
 ABSOLUTE_BOUND = 0.01
+"""See :data:`RELATIVE_BOUND`, metres."""
 
 
 @dataclass(frozen=True)

@@ -835,7 +835,7 @@ def build_parser() -> argparse.ArgumentParser:
         "(default: the graph method) on a real log as read and on copies degraded with seeds "
         "0..N-1 (--range-noise, --drop-scans, --clutter; or --last-bit-draws), each measured "
         "against the log's benchmark relations, and count the runs whose relation error "
-        "moved by more than 25 %% or 1 cm (whichever is larger) from the run on the log as "
+        "moved by more than 25 % or 1 cm (whichever is larger) from the run on the log as "
         "read: issue 10's robustness bound.",
     )
     p.add_argument("--world", help="world to simulate (default paper)")
@@ -880,7 +880,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     g = p.add_argument_group(
         "robustness checks",
-        "degrade every simulated log before its runs, as `fhslam slam` does "
+        "degrade every simulated log (or --log's) before its runs, as `fhslam slam` does "
         "(fhslam.sim.degrade, fhslam.sim.perturb_odometry); the CSV file records it",
     )
     _degrade_arguments(g, seed_default=None)

@@ -1001,6 +1001,8 @@ def _sweep(args: argparse.Namespace) -> None:
     )
     if args.out is not None:
         compare.save_sweep(rows, args.out)
+    if args.set:  # not in the file: its columns are fixed (notebook 07 reads it)
+        print("the graph method with " + " ".join(f"--set {x}" for x in args.set))
     print(compare.format_summary(rows))
 
 

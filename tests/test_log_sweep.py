@@ -131,6 +131,8 @@ def test_the_table_names_the_runs_beyond_the_bound():
 
 
 def test_graph_parameters_reach_the_runs(hall, capsys):
+    from fhslam.slam import GraphSlamParams
+
     """``--set`` (``params``): keyframes every metre instead of every half metre move the
     run; the table says so."""
     path, relations = hall
@@ -140,7 +142,13 @@ def test_graph_parameters_reach_the_runs(hall, capsys):
     default = capsys.readouterr().out.splitlines()[0]
     assert main([*args, "--set", "keyframe_distance=1.0"]) == 0
     other = capsys.readouterr().out.splitlines()[0]
-    assert default.startswith(f"{path}, graph: as read ") and other != default
+    assert default.startswith(f"{path}, graph: as read ")
+    assert other.startswith(f"{path}, graph (keyframe_distance=1.0): as read ")
+    assert other.partition(" as read ")[2] != default.partition(" as read ")[2]
+    params = GraphSlamParams(keyframe_distance=1.0)
+    kw = dict(seeds=[0], range_noise=0.001, n_jobs=1, progress=False, params=params)
+    rows = log_sweep(path, relations, methods=("graph", "fht"), **kw)
+    assert [r.settings for r in rows] == ["keyframe_distance=1.0"] * 2 + [""] * 2
 
 
 def test_the_simulated_sweep_takes_graph_parameters_too(monkeypatch, capsys):
@@ -151,6 +159,7 @@ def test_the_simulated_sweep_takes_graph_parameters_too(monkeypatch, capsys):
     monkeypatch.setattr(compare, "slam_sweep", lambda **kw: seen.update(kw) or [])
     monkeypatch.setattr(compare, "format_summary", lambda rows: "")
     assert main(["sweep", "--world", "hall", "--set", "smooth_clouds=true", "--quiet"]) == 0
+    assert capsys.readouterr().out.startswith("the graph method with --set smooth_clouds=true")
     assert seen["params"] == GraphSlamParams(smooth_clouds=True)
     assert seen["methods"] == ["fht", "graph", "classical", "ekf", "odometry"]
     assert (seen["world"], seen["levels"], seen["degrade_seed"]) == (

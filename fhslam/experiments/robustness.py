@@ -63,6 +63,9 @@ class LogRun:
     n_relations: int
     """Relations used (both timestamps found among the run's scans)."""
     seconds: float
+    settings: str = ""
+    """The ``graph`` method's parameters that differ from their defaults
+    (``"loop_target_keyframes=6"``; empty: the defaults, or another method)."""
 
     @property
     def reference(self) -> bool:
@@ -105,8 +108,20 @@ def _one(
     return LogRun(
         name, method, changed["range_noise"], changed["drop_fraction"],
         changed["clutter_fraction"], seed, last_bit, e.trans_mean, e.rot_mean_deg, e.n_used,
-        seconds,
+        seconds, _settings(params) if method == "graph" else "",
     )  # fmt: skip
+
+
+def _settings(params: object | None) -> str:
+    """The fields of a parameter dataclass that differ from its defaults, ``name=value``."""
+    if params is None:
+        return ""
+    default = type(params)()
+    return " ".join(
+        f"{f.name}={getattr(params, f.name)!r}"
+        for f in fields(params)
+        if getattr(params, f.name) != getattr(default, f.name)
+    )
 
 
 def log_sweep(
@@ -224,8 +239,9 @@ def format_log_sweep(rows: Sequence[LogRun]) -> str:
         sel = [r for r in rows if r.method == method]
         ref = next(r for r in sel if r.reference)
         others = [r for r in sel if not r.reference]
+        label = f"{method} ({ref.settings})" if ref.settings else method
         lines.append(
-            f"{ref.log}, {method}: as read {ref.trans_error:.4f} m, {ref.rot_error_deg:.2f} deg "
+            f"{ref.log}, {label}: as read {ref.trans_error:.4f} m, {ref.rot_error_deg:.2f} deg "
             f"({ref.n_relations} relations, {ref.seconds:.1f} s)"
         )
         if not others:

@@ -143,6 +143,21 @@ def one_run(
     return out
 
 
+def check_runs(methods: Sequence[str], params: object | None, last_bit_draws: int) -> None:
+    """What every sweep checks before its first run (:func:`slam_sweep`,
+    :func:`fhslam.experiments.robustness.log_sweep`): known methods, ``params`` only with
+    the graph method, ``last_bit_draws`` a whole number >= 0; ``ValueError`` otherwise."""
+    unknown = set(methods) - set(METHODS)
+    if unknown:
+        raise ValueError(f"unknown SLAM methods {sorted(unknown)}; choose from {list(METHODS)}")
+    if params is not None and "graph" not in methods:
+        raise ValueError("params apply to the graph method only, which is not among the methods")
+    if isinstance(last_bit_draws, bool) or not (
+        isinstance(last_bit_draws, int | np.integer) and last_bit_draws >= 0
+    ):
+        raise ValueError(f"last_bit_draws must be a whole number >= 0, got {last_bit_draws!r}")
+
+
 def slam_sweep(
     world: str = "paper",
     seeds: Sequence[int] = range(20),
@@ -184,15 +199,7 @@ def slam_sweep(
         If a method is unknown, ``last_bit_draws`` is not a whole number >= 0 or the
         degradation is not one :func:`fhslam.sim.degrade` takes; before any run starts.
     """
-    unknown = set(methods) - set(METHODS)
-    if unknown:
-        raise ValueError(f"unknown SLAM methods {sorted(unknown)}; choose from {list(METHODS)}")
-    if params is not None and "graph" not in methods:
-        raise ValueError("params apply to the graph method only, which is not among the methods")
-    if isinstance(last_bit_draws, bool) or not (
-        isinstance(last_bit_draws, int | np.integer) and last_bit_draws >= 0
-    ):
-        raise ValueError(f"last_bit_draws must be a whole number >= 0, got {last_bit_draws!r}")
+    check_runs(methods, params, last_bit_draws)
     drop_fraction, clutter_fraction, degrade_seed, range_noise = check_degradation(
         drop_fraction, clutter_fraction, degrade_seed, range_noise
     )

@@ -24,7 +24,11 @@ from tqdm.auto import tqdm
 from fhslam import metrics
 from fhslam.datasets import DATASETS, find_dataset, load_log
 from fhslam.errors import InputError
-from fhslam.experiments.compare import _thread_lock_for_tqdm, _workers_deaf_to_ctrl_c
+from fhslam.experiments.compare import (
+    _thread_lock_for_tqdm,
+    _workers_deaf_to_ctrl_c,
+    check_runs,
+)
 from fhslam.io import Log, read_relations
 from fhslam.io.files import atomic_output
 from fhslam.pipeline import METHODS, run_slam
@@ -172,15 +176,9 @@ def log_sweep(
     ValueError
         For an unknown method, or ``params`` without the ``graph`` method.
     """
-    unknown = set(methods) - set(METHODS)
-    if unknown or not methods:
-        raise ValueError(f"unknown SLAM methods {sorted(unknown)}; choose from {list(METHODS)}")
-    if params is not None and "graph" not in methods:
-        raise ValueError("params apply to the graph method only, which is not among the methods")
-    if isinstance(last_bit_draws, bool) or not (
-        isinstance(last_bit_draws, int | np.integer) and last_bit_draws >= 0
-    ):
-        raise ValueError(f"last_bit_draws must be a whole number >= 0, got {last_bit_draws!r}")
+    if not methods:
+        raise ValueError(f"no SLAM method given; choose from {list(METHODS)}")
+    check_runs(methods, params, last_bit_draws)
     drop_fraction, clutter_fraction, _, range_noise = check_degradation(
         drop_fraction, clutter_fraction, 0, range_noise
     )

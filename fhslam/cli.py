@@ -383,16 +383,22 @@ def _slam(args: argparse.Namespace) -> None:
 
 def _graph_params(pairs: list[str]):
     """The :class:`~fhslam.slam.GraphSlamParams` of ``slam --set NAME=VALUE`` options: the
-    defaults, with each named number or switch (a field of type bool, int or float) set."""
+    defaults, with each named number or switch (a field of type bool, int or float) set;
+    ``tracker.NAME`` names one of its :class:`~fhslam.slam.tracker.TrackerParams`."""
     import math
     from dataclasses import fields
 
     from fhslam.errors import InputError
     from fhslam.slam import GraphSlamParams
+    from fhslam.slam.tracker import TrackerParams
 
-    kinds = {f.name: getattr(f.type, "__name__", str(f.type)) for f in fields(GraphSlamParams)}
+    def kinds_of(cls, prefix=""):
+        return {prefix + f.name: getattr(f.type, "__name__", str(f.type)) for f in fields(cls)}
+
+    kinds = {**kinds_of(GraphSlamParams), **kinds_of(TrackerParams, "tracker.")}
     settable = sorted(n for n, k in kinds.items() if k in ("bool", "int", "float"))
     values: dict[str, object] = {}
+    tracker: dict[str, object] = {}
     for pair in pairs:
         name, sep, text = (x.strip() for x in pair.partition("="))
         if not sep or not name or not text:
@@ -400,8 +406,8 @@ def _graph_params(pairs: list[str]):
         kind = kinds.get(name)
         if kind not in ("bool", "int", "float"):
             raise InputError(
-                f"--set {pair!r}: {name!r} is not a number or switch of GraphSlamParams; "
-                f"one of: {', '.join(settable)}"
+                f"--set {pair!r}: {name!r} is not a number or switch of GraphSlamParams "
+                f"(or, as tracker.NAME, of its TrackerParams); one of: {', '.join(settable)}"
             )
         try:
             if kind == "bool":
@@ -415,8 +421,13 @@ def _graph_params(pairs: list[str]):
         except ValueError:
             wanted = {"bool": "true or false", "int": "an integer", "float": "a finite number"}
             raise InputError(f"--set {pair!r}: {name} takes {wanted[kind]}, got {text!r}") from None
-        values[name] = value
+        if name.startswith("tracker."):
+            tracker[name.removeprefix("tracker.")] = value
+        else:
+            values[name] = value
     try:
+        if tracker:
+            values["tracker"] = TrackerParams(**tracker)
         return GraphSlamParams(**values)
     except ValueError as e:
         raise InputError(f"--set: {e}") from None
@@ -688,9 +699,9 @@ def build_parser() -> argparse.ArgumentParser:
         action="append",
         default=[],
         metavar="NAME=VALUE",
-        help="--method graph: set a number or switch of fhslam.slam.GraphSlamParams (repeat "
-        "for more), e.g. --set loop_target_keyframes=6 --set smooth_clouds=true; the "
-        "trajectory's header records it",
+        help="--method graph: set a number or switch of fhslam.slam.GraphSlamParams, or as "
+        "tracker.NAME of its scan tracker's TrackerParams (repeat for more), e.g. --set "
+        "loop_target_keyframes=6 --set tracker.window=0.3; the trajectory's header records it",
     )
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.add_argument("--profile", action="store_true", help=PROFILE_HELP)
@@ -872,8 +883,9 @@ def build_parser() -> argparse.ArgumentParser:
         action="append",
         default=[],
         metavar="NAME=VALUE",
-        help="set a number or switch of fhslam.slam.GraphSlamParams for the graph method's "
-        "runs, as `fhslam slam --set` does (repeat for more)",
+        help="set a number or switch of fhslam.slam.GraphSlamParams (tracker.NAME: of its "
+        "TrackerParams) for the graph method's runs, as `fhslam slam --set` does (repeat for "
+        "more); --out's CSV records them in its settings column",
     )
     p.add_argument("--jobs", type=int, default=-1, help="worker processes (default: all cores)")
     p.add_argument("--out", type=Path, help="write every run to this CSV file")

@@ -921,10 +921,34 @@ def test_slam_set_runs_the_graph_method_with_those_parameters(short_clf, tmp_pat
     assert np.abs(default - expected.poses).max() > 1e-6  # the smoothing changed the run
 
 
+def test_slam_set_reaches_the_trackers_parameters(short_clf, tmp_path):
+    """``--set tracker.NAME=VALUE`` sets a number of the scan tracker's ``TrackerParams``
+    (``GraphSlamParams.tracker``), beside the graph's own."""
+    from fhslam.pipeline import run_slam
+    from fhslam.slam import GraphSlamParams
+    from fhslam.slam.tracker import TrackerParams
+
+    out = tmp_path / "t.txt"
+    sets = ["--set", "tracker.window=0.3", "--set", "tracker.angle_step_deg=1", "--set",
+            "loop_target_keyframes=4"]  # fmt: skip
+    assert main(["slam", str(short_clf), "--trajectory", str(out), "--quiet", *sets]) == 0
+    log = read_carmen(short_clf)
+    tracker = TrackerParams(window=0.3, angle_step_deg=1.0)
+    expected = run_slam(log, params=GraphSlamParams(tracker=tracker, loop_target_keyframes=4))
+    t, poses = read_trajectory(out)
+    np.testing.assert_array_equal(t, expected.timestamps)
+    np.testing.assert_allclose(poses, expected.poses, atol=1e-9)
+    assert np.abs(run_slam(log).poses - expected.poses).max() > 1e-6
+
+
 @pytest.mark.parametrize(
     ("setting", "message"),
     [
-        ("foo=1", "'foo' is not a number or switch of GraphSlamParams; one of: cloud_max_range"),
+        (
+            "foo=1",
+            "'foo' is not a number or switch of GraphSlamParams (or, as tracker.NAME, of its "
+            "TrackerParams); one of: cloud_max_range",
+        ),
         ("tracker=1", "'tracker' is not a number or switch"),
         ("odometry_sigma=0.1", "'odometry_sigma' is not a number or switch"),
         ("loop_target_keyframes=1.5", "loop_target_keyframes takes an integer, got '1.5'"),
@@ -933,6 +957,10 @@ def test_slam_set_runs_the_graph_method_with_those_parameters(short_clf, tmp_pat
         ("loop_min_score=1.5", r"--set: loop_min_score must be in [0, 1], got 1.5"),
         ("loop_target_keyframes=-1", "loop_target_keyframes >= 0"),
         ("loop_target_keyframes", "expected NAME=VALUE"),
+        ("tracker.foo=1", "'tracker.foo' is not a number or switch"),
+        ("tracker.prior_sigma=1", "'tracker.prior_sigma' is not a number or switch"),
+        ("tracker.refine_iterations=2.5", "tracker.refine_iterations takes an integer"),
+        ("tracker.sigma=0", "--set: TrackerParams.sigma must be > 0, got 0.0"),
         ("=6", "expected NAME=VALUE"),
     ],
 )

@@ -72,6 +72,8 @@ def test_the_committed_sweep_is_what_this_code_computes(runs):
 
 OLD = ",".join(FIELDS[:8])
 """The header of sweep files written before the sweep could degrade its logs."""
+MID = ",".join(FIELDS[:13])
+"""... and before they recorded the graph method's settings."""
 
 
 @pytest.mark.parametrize(
@@ -80,16 +82,17 @@ OLD = ",".join(FIELDS[:8])
         ("", ":1: not a sweep file"),
         ("a,b,c\n1,2,3\n", ":1: not a sweep file"),
         (",".join(FIELDS) + "\n", "no runs"),
-        (",".join(FIELDS) + "\nfht,low,0,0.1,0.2,0.3,1.0,5\n", ":2: 8 fields, expected 13"),
+        (",".join(FIELDS) + "\nfht,low,0,0.1,0.2,0.3,1.0,5\n", ":2: 8 fields, expected 14"),
+        (MID + "\nfht,low,0,0.1,0.2,0.3,1.0,5,0,0,0,0,0,x\n", ":2: 14 fields, expected 13"),
         (OLD + "\nfht,low,0,0.1\n", ":2: 4 fields, expected 8"),
         (OLD + "\nfht,low,zero,0.1,0.2,0.3,1.0,5\n", ":2: not a number"),
         (
-            ",".join(FIELDS) + "\nfht,low,0,0.1,0.2,0.3,1.0,5,0.001,0.1,0,0,one\n",
+            MID + "\nfht,low,0,0.1,0.2,0.3,1.0,5,0.001,0.1,0,0,one\n",
             ":2: not a number",
         ),
         (OLD + "\nslow,low,0,0.1,0.2,0.3,1.0,5\n", ":2: unknown method 'slow'"),
-        (",".join(FIELDS) + "\nfht,low,0,0.1,0.2,0.3,1.0,5,0,1.5,0,0,0\n", ":2: not a degradation"),
-        (",".join(FIELDS) + "\nfht,low,0,0.1,0.2,0.3,1.0,5,0,0,0,0,-1\n", "last_bit must be >= 0"),
+        (MID + "\nfht,low,0,0.1,0.2,0.3,1.0,5,0,1.5,0,0,0\n", ":2: not a degradation"),
+        (",".join(FIELDS) + "\nfht,low,0,0.1,0.2,0.3,1.0,5,0,0,0,0,-1,\n", "last_bit must be >= 0"),
         (OLD + "\nfht,huge,0,0.1,0.2,0.3,1.0,5\n", ":2: unknown noise level"),
     ],
 )
@@ -141,6 +144,40 @@ def test_a_file_from_before_the_degradation_columns_reads_as_not_degraded(tmp_pa
     assert (r.range_noise, r.drop_fraction, r.clutter_fraction, r.degrade_seed, r.last_bit) == (
         0.0, 0.0, 0.0, 0, 0,
     )  # fmt: skip
+
+
+def test_a_file_from_before_the_settings_column_reads_as_the_defaults(tmp_path):
+    path = tmp_path / "mid.csv"
+    path.write_text(MID + "\ngraph,low,3,0.05,0.9,0.012,2.5,17,0.001,0.1,0.0,2,1\n")
+    (r,) = load_sweep(path)
+    assert (r.method, r.seed, r.range_noise, r.degrade_seed, r.last_bit) == (
+        "graph", 3, 0.001, 2, 1,
+    )  # fmt: skip
+    assert r.settings == ""
+
+
+def test_the_graph_methods_settings_are_recorded_row_by_row(tmp_path):
+    """A sweep with ``params`` records, in the graph method's rows only, the parameters that
+    differ from the defaults as ``--set`` names them (a tracker parameter as
+    ``tracker.NAME``); the file reads back with them."""
+    from fhslam.experiments.compare import settings_text, slam_sweep
+    from fhslam.slam import GraphSlamParams
+    from fhslam.slam.tracker import TrackerParams
+
+    params = GraphSlamParams(loop_target_keyframes=6, tracker=TrackerParams(window=0.3))
+    assert settings_text(params) == "tracker.window=0.3 loop_target_keyframes=6"
+    assert settings_text(GraphSlamParams()) == settings_text(None) == ""
+    rows = slam_sweep(
+        "corridor", seeds=[0], levels=["low"], methods=["odometry", "graph"], n_jobs=1,
+        progress=False, params=params,
+    )  # fmt: skip
+    assert [(r.method, r.settings) for r in rows] == [
+        ("odometry", ""),
+        ("graph", "tracker.window=0.3 loop_target_keyframes=6"),
+    ]
+    save_sweep(rows, tmp_path / "s.csv")
+    assert tmp_path.joinpath("s.csv").read_text().splitlines()[0].endswith(",last_bit,settings")
+    assert [r.settings for r in load_sweep(tmp_path / "s.csv")] == [r.settings for r in rows]
 
 
 def test_a_degraded_run_is_the_run_on_the_degraded_log():

@@ -52,10 +52,11 @@ def noise_levels() -> dict[str, OdometryNoise]:
 class RunResult:
     """One method on one simulated log.
 
-    The last five fields say how the log was changed before the run (all zero: not at all):
+    Five fields say how the log was changed before the run (all zero: not at all):
     :func:`fhslam.sim.degrade`'s ``range_noise``, ``drop_fraction`` and ``clutter_fraction``
     drawn with ``degrade_seed``, then :func:`fhslam.sim.perturb_odometry` with seed
-    ``last_bit`` (0: the odometry as simulated).
+    ``last_bit`` (0: the odometry as simulated); the last, ``settings``, which of the
+    ``graph`` method's parameters differed from their defaults (:func:`settings_text`).
     """
 
     method: str
@@ -71,6 +72,27 @@ class RunResult:
     clutter_fraction: float = 0.0
     degrade_seed: int = 0
     last_bit: int = 0
+    settings: str = ""
+
+
+def settings_text(params: object | None, prefix: str = "") -> str:
+    """The fields of a parameter dataclass that differ from its defaults, as ``fhslam slam
+    --set`` names them: ``"tracker.window=0.3 loop_target_keyframes=6"`` (a nested parameter
+    dataclass, such as :class:`~fhslam.slam.GraphSlamParams`'s ``tracker``, field by field);
+    empty for ``None`` or the defaults."""
+    if params is None:
+        return ""
+    default = type(params)()
+    out = []
+    for f in fields(params):
+        value, base = getattr(params, f.name), getattr(default, f.name)
+        if value == base:
+            continue
+        if hasattr(value, "__dataclass_fields__") and type(value) is type(base):
+            out.append(settings_text(value, f"{prefix}{f.name}."))
+        else:
+            out.append(f"{prefix}{f.name}={value!r}")
+    return " ".join(out)
 
 
 def _thread_lock_for_tqdm() -> None:
@@ -138,6 +160,7 @@ def one_run(
                 **changed,
                 degrade_seed=degrade_seed,
                 last_bit=last_bit,
+                settings=settings_text(params) if m == "graph" else "",
             )
         )
     return out
@@ -356,9 +379,10 @@ def load_sweep(path: str | os.PathLike[str]) -> list[RunResult]:
         raise InputError(f"{p}: cannot read ({e})") from None
     reader = csv.reader(text.splitlines())
     header = next(reader, None)
-    # files written before the sweep could degrade its logs have the first eight columns
+    # files written before the sweep could degrade its logs have the first eight columns,
+    # before it recorded the graph method's settings the first thirteen
     names = tuple(header or ())
-    if names not in (FIELDS, FIELDS[:8]):
+    if names not in (FIELDS, FIELDS[:13], FIELDS[:8]):
         raise InputError(f"{p}:1: not a sweep file (expected the header {','.join(FIELDS)})")
     types = [f.type for f in fields(RunResult)]
     rows = []

@@ -28,6 +28,7 @@ from fhslam.experiments.compare import (
     _thread_lock_for_tqdm,
     _workers_deaf_to_ctrl_c,
     check_runs,
+    settings_text,
 )
 from fhslam.io import Log, read_relations
 from fhslam.io.files import atomic_output
@@ -112,20 +113,8 @@ def _one(
     return LogRun(
         name, method, changed["range_noise"], changed["drop_fraction"],
         changed["clutter_fraction"], seed, last_bit, e.trans_mean, e.rot_mean_deg, e.n_used,
-        seconds, _settings(params) if method == "graph" else "",
+        seconds, settings_text(params) if method == "graph" else "",
     )  # fmt: skip
-
-
-def _settings(params: object | None) -> str:
-    """The fields of a parameter dataclass that differ from its defaults, ``name=value``."""
-    if params is None:
-        return ""
-    default = type(params)()
-    return " ".join(
-        f"{f.name}={getattr(params, f.name)!r}"
-        for f in fields(params)
-        if getattr(params, f.name) != getattr(default, f.name)
-    )
 
 
 def log_sweep(

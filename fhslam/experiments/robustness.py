@@ -69,8 +69,9 @@ class LogRun:
     """Relations used (both timestamps found among the run's scans)."""
     seconds: float
     settings: str = ""
-    """The ``graph`` method's parameters that differ from their defaults
-    (``"loop_target_keyframes=6"``; empty: the defaults, or another method)."""
+    """The ``graph`` method's parameters that differ from their defaults, as ``--set``
+    names them (``"loop_target_keyframes=6 tracker.window=0.3"``: :func:`~fhslam.experiments.
+    compare.settings_text`; empty: the defaults, or another method)."""
 
     @property
     def reference(self) -> bool:

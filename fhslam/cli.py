@@ -231,11 +231,10 @@ def _plot_errors(args: argparse.Namespace, reference: Path, max_diff: float) -> 
     import matplotlib
 
     matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
 
     from fhslam.figures import pose_errors_figure, relation_errors_figure
     from fhslam.io import read_relations, read_trajectory
-    from fhslam.io.files import atomic_output, check_outputs
+    from fhslam.io.files import check_outputs
 
     inputs = {"the trajectory": args.trajectory, "the reference": reference}
     check_outputs({"--plot": args.plot}, inputs)
@@ -248,11 +247,7 @@ def _plot_errors(args: argparse.Namespace, reference: Path, max_diff: float) -> 
         else:
             t_ref, ref = read_trajectory(reference)
             fig = pose_errors_figure(t, poses, t_ref, ref, max_diff, args.align, title)
-    try:
-        with atomic_output(args.plot, "wb") as f:
-            fig.savefig(f, format="png", dpi=100, bbox_inches="tight", metadata={"Software": None})
-    finally:
-        plt.close(fig)
+    _save_png(fig, args.plot)
 
 
 def _check_delta(trajectory: Path, truth: Path, max_diff: float, delta: int) -> None:
@@ -460,22 +455,28 @@ def _degraded(log, args: argparse.Namespace):
     return log, ", ".join(done)
 
 
-def _write_plot(path: Path, log, result, method: str, graph) -> None:
-    """Draw the run (:func:`fhslam.figures.slam_run_figure`) into the PNG ``path``."""
-    import matplotlib
-
-    matplotlib.use("Agg")
+def _save_png(fig, path: Path) -> None:
+    """Write a figure as the PNG ``path`` (whole or not at all), then close it."""
     import matplotlib.pyplot as plt
 
-    from fhslam.figures import slam_run_figure
     from fhslam.io.files import atomic_output
 
-    fig = slam_run_figure(log, result, method, graph)
     try:
         with atomic_output(path, "wb") as f:
             fig.savefig(f, format="png", dpi=100, bbox_inches="tight", metadata={"Software": None})
     finally:
         plt.close(fig)
+
+
+def _write_plot(path: Path, log, result, method: str, graph) -> None:
+    """Draw the run (:func:`fhslam.figures.slam_run_figure`) into the PNG ``path``."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+
+    from fhslam.figures import slam_run_figure
+
+    _save_png(slam_run_figure(log, result, method, graph), path)
 
 
 def _bench(args: argparse.Namespace) -> None:
@@ -889,6 +890,13 @@ def build_parser() -> argparse.ArgumentParser:
     )
     p.add_argument("--jobs", type=int, default=-1, help="worker processes (default: all cores)")
     p.add_argument("--out", type=Path, help="write every run to this CSV file")
+    p.add_argument(
+        "--plot",
+        type=Path,
+        metavar="RUNS.png",
+        help="--log: draw every run's relation error against the run on the log as read and "
+        "issue 10's bound (fhslam.figures.sweep_errors_figure)",
+    )
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     g = p.add_argument_group(
         "robustness checks",
@@ -990,6 +998,8 @@ def _sweep(args: argparse.Namespace) -> None:
         return
     if args.relations is not None:
         raise InputError("--relations: only with --log")
+    if args.plot is not None:
+        raise InputError("--plot: only with --log")
     world_name = "paper" if args.world is None else args.world
     world = load_world(world_name)  # a bad world is an error before any worker starts
     builtin = world_name in BUILTIN_WORLDS or world_name.startswith("random:")
@@ -1038,7 +1048,9 @@ def _log_sweep(args: argparse.Namespace, methods: list[str], params) -> None:
             f"{', '.join(given)}: not with --log (its own odometry; --seeds N draws the "
             "degradation with seeds 0..N-1)"
         )
-    check_outputs({"--out": args.out}, {"--log": args.log, "--relations": args.relations})
+    check_outputs(
+        {"--out": args.out, "--plot": args.plot}, {"--log": args.log, "--relations": args.relations}
+    )
     rows = robustness.log_sweep(
         args.log,
         args.relations,
@@ -1055,6 +1067,17 @@ def _log_sweep(args: argparse.Namespace, methods: list[str], params) -> None:
     if args.out is not None:
         robustness.save_log_sweep(rows, args.out)
     print(robustness.format_log_sweep(rows))
+    if args.plot is not None:
+        import matplotlib
+
+        matplotlib.use("Agg")
+        from fhslam.figures import sweep_errors_figure
+
+        degraded = next((r for r in rows if not r.reference), rows[0])
+        title = f"{rows[0].log}: {robustness.degradation_text(degraded)}"
+        bounds = robustness.RELATIVE_BOUND, robustness.ABSOLUTE_BOUND
+        _save_png(sweep_errors_figure(rows, *bounds, title), args.plot)
+        print(f"wrote a picture of the runs to {args.plot}")
 
 
 def _student_copy(args: argparse.Namespace) -> None:
@@ -1078,7 +1101,7 @@ def _show_warning(message, category, filename, lineno, file=None, line=None) -> 
 _OUTPUTS = {
     "simulate": ("--log", "--truth"),
     "slam": ("--trajectory", "--map", "--graph"),
-    "sweep": ("--out",),
+    "sweep": ("--out", "--plot"),
     "reproduce": ("--out",),
     "student-copy": ("out",),
 }

@@ -226,3 +226,62 @@ def test_the_python_call_refuses_bad_arguments(hall):
         log_sweep(path, relations, seeds=[], range_noise=0.001)
     with pytest.raises(ValueError, match="range_noise must be a finite number"):
         log_sweep(path, relations, range_noise=np.nan)
+
+
+def _drawn(seed: int, error: float, method: str = "graph", last_bit: int = 0) -> LogRun:
+    return LogRun("h.clf", method, 0.001 if seed >= 0 else 0.0, 0.0, 0.0, seed, last_bit,
+                  error, 0.5, 60, 1.0)  # fmt: skip
+
+
+def test_the_picture_marks_the_runs_beyond_the_bound():
+    """``sweep_errors_figure``: a panel per method, the run as read as a line with issue 10's
+    bound as a band about it, the runs beyond it red and labelled with their error."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from fhslam.figures import sweep_errors_figure
+
+    graph = [_drawn(-1, 0.1), _drawn(0, 0.11), _drawn(1, 0.5), _drawn(2, 0.124)]
+    fht = [_drawn(-1, 0.2, "fht"), _drawn(0, 0.005, "fht"), _drawn(-1, 0.003, "fht", last_bit=1)]
+    runs = graph + fht
+    fig = sweep_errors_figure(runs, title="h.clf: 1 mm of range noise")
+    try:
+        left, right = fig.axes
+        assert left.get_title() == "graph: 3 runs, 1 beyond the bound"
+        assert right.get_title() == "fht: 2 runs, 2 beyond the bound"  # 0.195 and 0.197 m off
+        blue, red = left.collections[-2:]
+        assert [tuple(p) for p in red.get_offsets()] == [(1.0, 0.5)]
+        assert sorted(y for _, y in blue.get_offsets()) == [0.11, 0.124]  # within 0.025 m
+        assert [t.get_text() for t in left.texts] == ["0.5 m"]
+        assert fig._suptitle.get_text() == "h.clf: 1 mm of range noise"
+        assert [t.get_text() for t in left.get_xticklabels()] == ["as read", "0", "1", "2"]
+    finally:
+        plt.close(fig)
+    # a reference of 3 mm: the band is issue 10's 1 cm, so 9 mm off is within it
+    small = sweep_errors_figure([_drawn(-1, 0.003), _drawn(0, 0.012), _drawn(1, 0.0135)])
+    try:
+        assert small.axes[0].get_title() == "graph: 2 runs, 1 beyond the bound"
+    finally:
+        plt.close(small)
+    with pytest.raises(ValueError, match="no runs to draw"):
+        sweep_errors_figure([])
+    with pytest.raises(ValueError, match="graph: no run on the log as read"):
+        sweep_errors_figure([_drawn(0, 0.1), _drawn(1, 0.1)])
+
+
+def test_sweep_plot_draws_the_runs(hall, tmp_path, capsys):
+    path, relations = hall
+    png = tmp_path / "runs.png"
+    args = ["sweep", "--log", str(path), "--relations", str(relations), "--range-noise",
+            "0.001", "--seeds", "1", "--jobs", "1", "--quiet", "--plot", str(png)]  # fmt: skip
+    assert main(args) == 0
+    assert capsys.readouterr().out.endswith(f"wrote a picture of the runs to {png}\n")
+    assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" and png.stat().st_size > 10_000
+
+
+def test_sweep_plot_is_refused_without_a_log(tmp_path, capsys):
+    assert main(["sweep", "--world", "hall", "--plot", str(tmp_path / "p.png")]) == 2
+    assert capsys.readouterr().err == "fhslam: error: --plot: only with --log\n"
+    assert list(tmp_path.iterdir()) == []

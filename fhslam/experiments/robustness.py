@@ -210,7 +210,7 @@ def log_sweep(
     return list(tqdm(results, total=len(jobs), desc=desc, unit="run", disable=not progress))
 
 
-def _what(run: LogRun) -> str:
+def degradation_text(run: LogRun) -> str:
     """How ``run``'s log was changed, in words."""
     done = [f"{1000 * run.range_noise:g} mm of range noise"] if run.range_noise else []
     done += [f"{100 * run.drop_fraction:g} % of the scans dropped"] if run.drop_fraction else []
@@ -238,7 +238,7 @@ def format_log_sweep(rows: Sequence[LogRun]) -> str:
         out = [r for r in others if beyond(r, ref)]
         seeds = sorted({r.degrade_seed for r in others})
         draws = sorted({r.last_bit for r in others})
-        what = _what(others[0])
+        what = degradation_text(others[0])
         if seeds != [-1]:
             what += f", seeds {seeds[0]}-{seeds[-1]}" if len(seeds) > 1 else f", seed {seeds[0]}"
         if draws != [0]:

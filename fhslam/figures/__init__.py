@@ -15,7 +15,7 @@ writes them all (:func:`reproduce`). Everything is
 re-exported here, so ``from fhslam.figures import ...`` works for both.
 """
 
-from fhslam.figures.errors import pose_errors_figure, relation_errors_figure
+from fhslam.figures.errors import pose_errors_figure, relation_errors_figure, sweep_errors_figure
 from fhslam.figures.loop1 import (
     fig01_hough_principle,
     fig02_environment,
@@ -74,4 +74,5 @@ __all__ = [
     "similarity_examples",
     "slam_log",
     "slam_run_figure",
+    "sweep_errors_figure",
 ]

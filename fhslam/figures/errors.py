@@ -1,6 +1,7 @@
 """Pictures of a trajectory's errors, as ``fhslam evaluate --plot`` draws them: each benchmark
 relation's error over the run (:func:`relation_errors_figure`), and each pose's error against
-the truth (:func:`pose_errors_figure`).
+the truth (:func:`pose_errors_figure`); and of many runs' errors, as ``fhslam sweep --log
+--plot`` draws them (:func:`sweep_errors_figure`).
 
 A mean hides where a run went wrong: on the Freiburg hospital log the few relations across the
 unclosed return to the start are tens of metres off and the thousands under a minute a tenth
@@ -18,7 +19,7 @@ from numpy.typing import ArrayLike
 
 from fhslam import metrics, plotting
 
-__all__ = ["pose_errors_figure", "relation_errors_figure"]
+__all__ = ["pose_errors_figure", "relation_errors_figure", "sweep_errors_figure"]
 
 
 def _error_axis(ax, when, err, unit: str, level: float, label: str, **scatter):
@@ -109,4 +110,59 @@ def pose_errors_figure(
         f"{title + ': ' if title else ''}ATE{' aligned' if align else ''} rmse {rmse:.4f} m "
         f"over {len(i)} poses"
     )
+    return fig
+
+
+def sweep_errors_figure(
+    runs, relative: float = 0.25, absolute: float = 0.01, title: str = ""
+) -> Figure:
+    """Each run of a sweep over one log (``fhslam sweep --log``: objects with the fields of
+    :class:`fhslam.experiments.robustness.LogRun`) as a point: its mean translational relation
+    error over its degradation seed (the runs on the log as read at "as read", last-bit draws
+    beside their seed), one panel per method, with the run on the log as read as a line and
+    issue 10's bound about it (``relative`` of its error or ``absolute`` metres, whichever is
+    larger) as a band; the runs beyond it red and labelled.
+
+    Raises
+    ------
+    ValueError
+        When there are no runs, or a method has no run on the log as read.
+    """
+    runs = list(runs)
+    if not runs:
+        raise ValueError("no runs to draw")
+    methods = list(dict.fromkeys(r.method for r in runs))
+    fig, axes = plt.subplots(
+        1, len(methods), figsize=(max(6.5, 4.5 * len(methods)), 4.2), squeeze=False
+    )
+    draws = max(r.last_bit for r in runs) + 1
+    for ax, method in zip(axes[0], methods, strict=True):
+        mine = [r for r in runs if r.method == method]
+        refs = [r for r in mine if r.degrade_seed < 0 and r.last_bit == 0]
+        if not refs:
+            raise ValueError(f"{method}: no run on the log as read among the runs")
+        ref = refs[0].trans_error
+        bound = max(relative * ref, absolute)
+        others = [r for r in mine if r is not refs[0]]
+        x = np.array([r.degrade_seed + 0.5 * r.last_bit / draws for r in others])
+        e = np.array([r.trans_error for r in others])
+        out = np.abs(e - ref) > bound
+        ax.axhspan(max(ref - bound, ref / 10), ref + bound, color="0.9", lw=0)
+        ax.axhline(ref, color="k", lw=1, label=f"as read {ref:.4f} m (band: ± {bound:.3g} m)")
+        ax.scatter([-1], [ref], s=18, color="k")
+        ax.scatter(x[~out], e[~out], s=18, color="tab:blue", label="within issue 10's bound")
+        ax.scatter(x[out], e[out], s=24, color="tab:red", label="beyond it")
+        for xi, ei in zip(x[out], e[out], strict=True):
+            ax.annotate(f"{ei:.3g} m", (xi, ei), textcoords="offset points", xytext=(4, 3),
+                        fontsize=8, color="tab:red")  # fmt: skip
+        ax.set_yscale("log")
+        seeds = sorted({r.degrade_seed for r in others} | {-1})
+        ax.set_xticks(seeds, ["as read" if s < 0 else str(s) for s in seeds], fontsize=8)
+        ax.set_xlabel("degradation seed")
+        ax.set_ylabel("translational relation error (m)")
+        ax.set_title(f"{method}: {len(others)} runs, {int(out.sum())} beyond the bound")
+        ax.legend(loc="best", fontsize=8)
+    if title:
+        fig.suptitle(title)
+    fig.tight_layout()
     return fig

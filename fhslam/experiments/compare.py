@@ -17,7 +17,7 @@ import time
 import warnings
 from collections.abc import Iterator, Sequence
 from contextlib import contextmanager
-from dataclasses import astuple, dataclass, fields, replace
+from dataclasses import astuple, dataclass, fields, is_dataclass, replace
 from pathlib import Path
 
 import numpy as np
@@ -88,7 +88,7 @@ def settings_text(params: object | None, prefix: str = "") -> str:
         value, base = getattr(params, f.name), getattr(default, f.name)
         if value == base:
             continue
-        if hasattr(value, "__dataclass_fields__") and type(value) is type(base):
+        if is_dataclass(value) and type(value) is type(base):
             out.append(settings_text(value, f"{prefix}{f.name}."))
         else:
             out.append(f"{prefix}{f.name}={value!r}")

@@ -116,12 +116,12 @@ def pose_errors_figure(
 def sweep_errors_figure(
     runs, relative: float = 0.25, absolute: float = 0.01, title: str = ""
 ) -> Figure:
-    """Each run of a sweep over one log (``fhslam sweep --log``: objects with the fields of
-    :class:`fhslam.experiments.robustness.LogRun`) as a point: its mean translational relation
-    error over its degradation seed (the runs on the log as read at "as read", last-bit draws
-    beside their seed), one panel per method, with the run on the log as read as a line and
-    issue 10's bound about it (``relative`` of its error or ``absolute`` metres, whichever is
-    larger) as a band; the runs beyond it red and labelled.
+    """Each run of a sweep over one log (``fhslam sweep --log``: objects with the fields and
+    the ``reference`` property of :class:`fhslam.experiments.robustness.LogRun`) as a point:
+    its mean translational relation error over its degradation seed (the runs on the log as
+    read at "as read", last-bit draws beside their seed), one panel per method, with the run
+    on the log as read as a line and issue 10's bound about it (``relative`` of its error or
+    ``absolute`` metres, whichever is larger) as a band; the runs beyond it red and labelled.
 
     Raises
     ------
@@ -138,7 +138,7 @@ def sweep_errors_figure(
     draws = max(r.last_bit for r in runs) + 1
     for ax, method in zip(axes[0], methods, strict=True):
         mine = [r for r in runs if r.method == method]
-        refs = [r for r in mine if r.degrade_seed < 0 and r.last_bit == 0]
+        refs = [r for r in mine if r.reference]
         if not refs:
             raise ValueError(f"{method}: no run on the log as read among the runs")
         ref = refs[0].trans_error

@@ -202,6 +202,93 @@ def test_a_global_match_that_is_not_unique_is_not_taken():
     assert _closure_errors(slam, log).max(initial=0.0) <= 0.3  # measured: no closure
 
 
+def _straight_graph(params, n=80, spacing=0.5):
+    """A graph back end with ``n`` keyframes ``spacing`` metres apart on a straight line
+    (odometry edges only), for the global search's bookkeeping; ``slam._global_match`` is
+    to be replaced by canned matches."""
+    slam = GraphFastHoughSLAM(params, background=False)
+    for k in range(n):
+        slam._graph.add_node([k * spacing, 0.0, 0.0])
+        if k:
+            slam._graph.add_edge(k - 1, k, np.array([spacing, 0.0, 0.0]), np.eye(3) * 100)
+    slam._path = [k * spacing for k in range(n)]
+    return slam
+
+
+def _canned(slam, scores, offset=0.0):
+    """Make ``slam``'s global search return, for keyframe ``i`` in ``scores``, a match
+    against keyframe 0 that scores ``scores[i]`` (if that reaches the search's floor) and
+    puts keyframe ``i`` ``offset`` metres ahead of where the graph has it."""
+    from fhslam.geometry import compose, relative
+
+    asked = []
+
+    def match(i, poses, min_score):
+        asked.append((i, min_score))
+        score = scores.get(i, 0.0)
+        if score < min_score:
+            return None
+        placed = compose(poses[i], [offset, 0.0, 0.0])
+        return 0, i, relative(poses[0], placed), np.eye(3) * 100, score, placed
+
+    slam._global_match = match
+    return asked
+
+
+def test_a_held_global_match_is_confirmed_at_the_lower_score():
+    """``global_min_score`` finds a hypothesis, ``global_confirm_score`` confirms it: a
+    match at 0.52 is neither held nor refused as a confirmation; a hypothesis at 0.58 (over
+    0.55) is held, not closed, and the agreeing match nine keyframes on at 0.52 closes both."""
+    slam = _straight_graph(GraphSlamParams())
+    poses = slam._graph.poses
+    asked = _canned(slam, {20: 0.52, 40: 0.58, 49: 0.52})
+    assert not slam._search_globally(20, poses) and slam._hypothesis is None
+    assert not slam._search_globally(40, poses) and slam._hypothesis[1] == 40
+    assert not slam._search_globally(48, poses)  # queries may not share a keyframe
+    assert slam._search_globally(49, poses)
+    assert [(lc.old, lc.new) for lc in slam.loops] == [(0, 40), (0, 49)]
+    assert asked == [(20, 0.55), (40, 0.55), (49, 0.5)]
+    # with the confirmation as strict as the finding, the same match confirms nothing
+    strict = _straight_graph(GraphSlamParams(global_confirm_score=0.55))
+    _canned(strict, {40: 0.58, 49: 0.52})
+    assert not strict._search_globally(40, poses) and not strict._search_globally(49, poses)
+    assert strict.loops == [] and strict._hypothesis[1] == 40
+
+
+def test_a_weak_match_that_disagrees_leaves_the_hypothesis_held():
+    """A match under ``global_min_score`` that places the robot elsewhere (1 m off) neither
+    confirms the held hypothesis nor replaces it; one over it replaces it."""
+    slam = _straight_graph(GraphSlamParams())
+    poses = slam._graph.poses
+    _canned(slam, {40: 0.58})
+    slam._search_globally(40, poses)
+    _canned(slam, {49: 0.52, 50: 0.57}, offset=1.0)
+    assert not slam._search_globally(49, poses) and slam._hypothesis[1] == 40
+    assert not slam._search_globally(50, poses) and slam._hypothesis[1] == 50
+    assert slam.loops == []
+
+
+@pytest.mark.parametrize("lookback", [0.0, 1.0])
+def test_after_a_long_blind_stretch_the_global_search_stays_wide(lookback):
+    """``global_lookback``: a global closure that ended 34.5 m without a closure (keyframes
+    0.5 m apart, closed at keyframe 69) keeps the distance the global search counts (its
+    window; from 110 m also the estimate's guess) at 34.5 m for the next ``lookback × 34.5``
+    metres, and a global closure after a shorter stretch within them does not cut that
+    short. Without it the distance counts from each closure."""
+    slam = _straight_graph(GraphSlamParams(global_lookback=lookback), n=200)
+    poses = slam._graph.poses
+    _canned(slam, {60: 0.6, 69: 0.6, 100: 0.6, 109: 0.6})
+    slam._search_globally(60, poses)
+    assert slam._search_globally(69, poses)
+    assert slam._travelled(69) == (34.5 if lookback else 0.0)  # at the closure itself
+    assert slam._travelled(100) == (34.5 if lookback else 15.5)
+    slam._search_globally(100, poses)
+    assert slam._search_globally(109, poses)  # 20 m after the first closure
+    assert slam._travelled(120) == (34.5 if lookback else 5.5)
+    assert slam._travelled(137) == (34.5 if lookback else 14.0)  # 68.5 m: still within
+    assert slam._travelled(138) == 14.5  # at 69 m (34.5 + 34.5): counted from 54.5 m
+
+
 def test_a_candidate_that_failed_for_the_previous_keyframe_waits_a_keyframe(
     three_laps, monkeypatch
 ):
@@ -430,6 +517,8 @@ def test_without_loop_closures_no_loop_edges(three_laps):
         ("global_min_score", 1.5, r"global_min_score must be in \[0, 1\]"),
         ("global_max_ambiguity", 0.0, r"global_max_ambiguity must be in \(0, 1\]"),
         ("global_window_deg", 0.0, r"global_window_deg must be in \(0, 180\]"),
+        ("global_confirm_score", 1.5, r"global_confirm_score must be in \[0, 1\]"),
+        ("global_lookback", -1.0, "global_lookback must be >= 0"),
     ],
 )
 def test_bad_parameters_are_named(field, value, message):
@@ -438,13 +527,6 @@ def test_bad_parameters_are_named(field, value, message):
 
 
 # --------------------------------------------------------------------------- real logs
-
-
-CLINIC_DROPS_3 = (
-    "Freiburg hospital with 10 % of the scans dropped, degrade seed 3: 2.13 m (1 of 18 "
-    "perturbed runs measured at stop 31: range noise seeds 0-7, dropped scans 0-5, both 0-1, "
-    "last bit 1-2; the other 17 0.117-0.134 m)"
-)
 
 
 @functools.cache
@@ -534,20 +616,19 @@ def _clinic_error(params=None, **degraded) -> float:
     [
         {"range_noise": 0.001, "seed": 0},
         {"drop_fraction": 0.1, "seed": 0},
-        pytest.param(
-            {"drop_fraction": 0.1, "seed": 3},
-            marks=pytest.mark.xfail(strict=True, reason=CLINIC_DROPS_3),
-        ),
+        {"drop_fraction": 0.1, "seed": 3},
     ],
     ids=["range-noise", "dropped-scans", "dropped-scans-seed-3"],
 )
 def test_the_hospital_is_robust(real_data, degraded):
     """Issue 10's robustness: 1 mm of Gaussian noise on every range, or 10 % of the scans
-    dropped, may change the relation error by at most 25 % (or 1 cm). Measured 0.1277 m
-    with the noise and 0.1303 m with the drops (0.127 m unperturbed); before the global
+    dropped, may change the relation error by at most 25 % (or 1 cm). Measured 0.1270 m
+    with the noise, 0.1329 m with the drops and 0.1407 m with the drops of seed 3 (0.127 m
+    unperturbed). Seed 3 was a strict expected failure until stop 38 (2.13 m): its return
+    scored 0.59 where it was found, under the global search's old 0.6; before the global
     search looked where the odometry puts the robot, and from 10 m without a closure on,
-    3.14 m and 4.47 m: the return to the start lay 85-146 m and 25-40 degrees off the
-    estimate."""
+    the noise and the drops gave 3.14 m and 4.47 m: the return to the start lay 85-146 m
+    and 25-40 degrees off the estimate."""
     measured = REAL_LOGS["fr-clinic"][1]
     e = _clinic_error(**degraded)
     assert e <= _issue_10_bound(measured), f"{e:.4f} m"

@@ -281,8 +281,8 @@ class GraphSlamParams:
         more than ``global_min_score``; it must also be unique and agree with the hypothesis,
         which a chance match seldom does). Where the robot passes a place it comes back to only
         briefly, the queries after the one that found it see less of it: the hospital's
-        dropped-scans seed 11 held a match scoring 0.741 whose confirmations scored
-        0.53-0.56 (2.19 m unconfirmed; 0.124 m confirmed at 0.5).
+        dropped-scans seed 11 held a match scoring 0.741 whose 21 later queries scored
+        0.34-0.56 at best (2.19 m unconfirmed; 0.124 m confirmed at 0.5).
     global_window_deg : float
         See ``global_every``: twice the local search's ``loop_window_deg``.
     global_max_window : float

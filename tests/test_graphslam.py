@@ -289,6 +289,30 @@ def test_after_a_long_blind_stretch_the_global_search_stays_wide(lookback):
     assert slam._travelled(138) == 14.5  # at 69 m (34.5 + 34.5): counted from 54.5 m
 
 
+@pytest.mark.parametrize("reset", [False, True])
+def test_a_closure_within_the_blind_stretch_does_not_end_it(reset):
+    """``inner_closures_reset``: 30 m without a closure (keyframes 0.5 m apart, the last
+    closure at keyframe 0), a global hypothesis held at keyframe 50; a local closure of
+    keyframe 54 to keyframe 30 (15 m into the stretch, ``global_after`` 10 m) leaves the
+    stretch going on, and the hypothesis is confirmed at keyframe 59. Only a closure that
+    reaches back further (keyframe 10, 5 m in) ends it. Before stop 39 (``reset``) any
+    closure did, and the global search stopped with its hypothesis held."""
+    slam = _straight_graph(GraphSlamParams(inner_closures_reset=reset))
+    poses = slam._graph.poses
+    _canned(slam, {50: 0.6, 59: 0.6})
+    assert not slam._search_globally(50, poses) and slam._hypothesis[1] == 50
+    slam._end_blind(54, [30])
+    assert slam._travelled(59) == (2.5 if reset else 29.5)
+    assert (slam._travelled(59) >= slam.params.global_after) is not reset  # searched again?
+    assert slam._search_globally(59, poses) and slam._last_loop_path == 29.5
+    slam._last_loop_path = 0.0
+    slam._end_blind(62, [30, 10])  # one of them reaches back: the stretch ends
+    assert slam._last_loop_path == 31.0
+    slam._last_loop_path = 0.0
+    slam._end_blind(62, [19, 20])  # 9.5 m in: not as lost as the global search's start
+    assert slam._last_loop_path == 31.0
+
+
 def test_a_candidate_that_failed_for_the_previous_keyframe_waits_a_keyframe(
     three_laps, monkeypatch
 ):

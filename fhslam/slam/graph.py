@@ -300,6 +300,19 @@ class GraphSlamParams:
         (the hospital's: 9° at a spin between its start and the place its return meets
         first): the start, reached next, can lie 9-15 m off the corrected estimate, beyond
         the local search. Dropped-scans seed 2: 0.525 m without, 0.120 m with it.
+    inner_closures_reset : bool
+        Whether a local closure *within* the blind stretch ends it. A blind stretch is the
+        travel since the last closure; the local search's radius and the global search
+        count from where it began. A closure whose old keyframe lies ``global_after``
+        metres or more into that same stretch ties the robot to a place as lost as itself:
+        since stop 39 (False) the stretch goes on, unless one of the keyframe's closures
+        reaches further back. Before (True), it ended it and with it the global search, and
+        a hypothesis that search held was never confirmed: the Freiburg hospital's return
+        with loop targets of ± 6 keyframes for turned candidates (README, stop 39) failed
+        twice so: dropped-scans seed 1 (a closure of scans 6026/5955 between a hypothesis
+        at scan 6005 and its confirmation) 3.73 m, 0.130 m with the stretch going on; noise
+        seed 13 0.98 m, 0.121 m. With the default targets no hospital run changes its
+        outcome; MIT CSAIL and Freiburg 079 each make 2 global closures (none before).
     optimize_iterations : int
         Largest number of Gauss-Newton rounds after a keyframe that closed a loop...
     optimize_tol : float
@@ -349,6 +362,7 @@ class GraphSlamParams:
     global_max_ambiguity: float = 0.8
     global_confirm_score: float = 0.5
     global_lookback: float = 1.0
+    inner_closures_reset: bool = False
     optimize_iterations: int = 10
     optimize_tol: float = 1e-4
 
@@ -889,9 +903,18 @@ class GraphFastHoughSLAM:
             else:
                 self._pending.append(h)
         if closed:
-            self._last_loop_path = self._path[i]
+            self._end_blind(i, [lc.old for lc in self._loops[-len(closed) :]])
             if self._graph.chi2(np.array(closed)).max() >= p.loop_optimize_chi2:
                 self._optimize()
+
+    def _end_blind(self, i: int, olds) -> None:
+        """Book keyframe ``i``'s local closures to keyframes ``olds``: they end the blind
+        stretch unless every one of them lies ``global_after`` metres or more into it
+        (``inner_closures_reset``)."""
+        p = self.params
+        inner = all(self._path[j] - self._last_loop_path >= p.global_after for j in olds)
+        if p.inner_closures_reset or not inner:
+            self._last_loop_path = self._path[i]
 
     def _looks(self, poses, i: int) -> NDArray[np.float64]:
         """Where keyframes ``0 .. i`` looked: their clouds' means placed at ``poses``."""

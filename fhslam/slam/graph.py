@@ -841,8 +841,7 @@ class GraphFastHoughSLAM:
         n_old = i - p.loop_min_gap + 1  # keyframes old enough to be candidates
         drift = p.loop_growth * (self._path[i] - self._last_loop_path)
         radius = min(p.loop_max_radius, p.loop_radius + drift)
-        far = self._path[i] - self._last_loop_path >= p.global_after
-        if p.global_every and far and self._search_globally(i, poses):
+        if p.global_every and self._far(i) and self._search_globally(i, poses):
             return  # closed: the local search goes on from the next keyframe
         # Candidates: the keyframes that looked where this one's query looks (keyframes
         # i-2..i); where a keyframe looked is its cloud's mean, placed at its pose.
@@ -906,6 +905,11 @@ class GraphFastHoughSLAM:
             self._end_blind(i, [lc.old for lc in self._loops[-len(closed) :]])
             if self._graph.chi2(np.array(closed)).max() >= p.loop_optimize_chi2:
                 self._optimize()
+
+    def _far(self, i: int) -> bool:
+        """Whether keyframe ``i`` lies ``global_after`` metres or more past the last
+        closure, so that the global search runs."""
+        return self._path[i] - self._last_loop_path >= self.params.global_after
 
     def _end_blind(self, i: int, olds) -> None:
         """Book keyframe ``i``'s local closures to keyframes ``olds``: they end the blind

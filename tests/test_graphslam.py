@@ -268,6 +268,27 @@ def test_a_weak_match_that_disagrees_leaves_the_hypothesis_held():
     assert slam.loops == []
 
 
+@pytest.mark.parametrize(
+    ("tolerance", "off", "closes"), [(0.3, 0.25, True), (0.3, 0.35, False), (0.15, 0.25, False)]
+)
+def test_a_confirmation_agrees_within_global_consistency(tolerance, off, closes):
+    """``global_consistency``: a hypothesis held at keyframe 40 is confirmed at keyframe 49
+    by a match that puts the keyframe 0.25 m from where the hypothesis puts it (the Freiburg
+    hospital's right confirmations after its 900 m without a closure lie up to 0.22 m apart),
+    not by one 0.35 m off; with the local closures' 0.15 m (before stop 40) by neither. A
+    match that does not confirm is held instead."""
+    slam = _straight_graph(GraphSlamParams(global_consistency=tolerance))
+    poses = slam._graph.poses
+    _canned(slam, {40: 0.58})
+    assert not slam._search_globally(40, poses) and slam._hypothesis[1] == 40
+    _canned(slam, {49: 0.58}, offset=off)
+    assert slam._search_globally(49, poses) is closes
+    assert len(slam.loops) == (2 if closes else 0)
+    assert slam._hypothesis is None if closes else slam._hypothesis[1] == 49
+    with pytest.raises(ValueError, match="global_consistency_deg must be > 0"):
+        GraphSlamParams(global_consistency_deg=0.0)
+
+
 @pytest.mark.parametrize("lookback", [0.0, 1.0])
 def test_after_a_long_blind_stretch_the_global_search_stays_wide(lookback):
     """``global_lookback``: a global closure that ended 34.5 m without a closure (keyframes

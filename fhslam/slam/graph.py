@@ -256,7 +256,7 @@ class GraphSlamParams:
         score) and refines point-to-line like a local closure; and then only as a
         hypothesis, until the match of a query that shares no keyframe with its own (from
         ``global_keyframes`` keyframes on, until ``global_every`` more have passed) agrees
-        with it (``loop_consistency``, ``loop_consistency_deg``), scoring at least
+        with it (``global_consistency``, ``global_consistency_deg``), scoring at least
         ``global_confirm_score``; both then enter the graph.
         The Freiburg hospital comes back to its start after 900 m without a closure, its
         estimate 17-39 m and 12-25 degrees off (85-146 m and 25-40 degrees with 1 mm of
@@ -300,6 +300,19 @@ class GraphSlamParams:
         (the hospital's: 9° at a spin between its start and the place its return meets
         first): the start, reached next, can lie 9-15 m off the corrected estimate, beyond
         the local search. Dropped-scans seed 2: 0.525 m without, 0.120 m with it.
+    global_consistency : float
+        See ``global_every``: how far (metres) the match that confirms a hypothesis may put
+        its keyframe from where the hypothesis puts it (carried along the graph): twice the
+        local closures' ``loop_consistency``. After a long blind stretch the two matches
+        hit an old map that may be bent between the places they hit, with queries the
+        tracker may have bent; the Freiburg hospital's right confirmations at its return
+        after 900 m lie up to 0.22 m and 1.5 degrees apart, its other confirmations within
+        0.06 m and 0.4 degrees, and a wrong match is metres away (the ``ring``'s period
+        of 10 m, the ``campus``'s crossing of 2.5 m). Until stop 40 the local closures' 0.15 m
+        and 2 degrees: the hospital's dropped-scans seed 9 with ``smooth_clouds`` (0.159
+        m) and dropped scans and noise seed 0 likewise (0.186 m) missed their return.
+    global_consistency_deg : float
+        See ``global_consistency``: how far in heading, degrees.
     inner_closures_reset : bool
         Whether a local closure *within* the blind stretch ends it. A blind stretch is the
         travel since the last closure; the local search's radius and the global search
@@ -362,6 +375,8 @@ class GraphSlamParams:
     global_max_ambiguity: float = 0.8
     global_confirm_score: float = 0.5
     global_lookback: float = 1.0
+    global_consistency: float = 0.3
+    global_consistency_deg: float = 3.0
     inner_closures_reset: bool = False
     optimize_iterations: int = 10
     optimize_tol: float = 1e-4
@@ -378,6 +393,8 @@ class GraphSlamParams:
             "loop_confirm_deg",
             "loop_consistency",
             "loop_consistency_deg",
+            "global_consistency",
+            "global_consistency_deg",
         ):
             if not getattr(self, name) > 0:
                 raise ValueError(f"{name} must be > 0, got {getattr(self, name)}")
@@ -942,7 +959,8 @@ class GraphFastHoughSLAM:
         g = self._global_match(i, poses, low)
         if g is None:
             return False
-        if h is None or not self._agree(h, g, poses):
+        tol = (p.global_consistency, p.global_consistency_deg)
+        if h is None or not self._agree(h, g, poses, tol):
             if g[4] >= p.global_min_score:
                 self._hypothesis = g
             return False
@@ -1060,15 +1078,16 @@ class GraphFastHoughSLAM:
         a, b = self._target(g[0], g[1], 3), self._target(h[0], h[1], 3)
         return abs(g[1] - h[1]) >= 3 and max(a.start, b.start) >= min(a.stop, b.stop)
 
-    def _agree(self, g, h, poses) -> bool:
+    def _agree(self, g, h, poses, tol=None) -> bool:
         """Whether held closures ``g`` and ``h`` place keyframe ``h``'s ``i`` alike (``g``'s
-        placement carried along the graph)."""
+        placement carried along the graph): within ``tol`` (metres, degrees; default
+        ``loop_consistency``, ``loop_consistency_deg``)."""
         p = self.params
+        dist, deg = tol or (p.loop_consistency, p.loop_consistency_deg)
         carried = compose(g[5], relative(poses[g[1]], poses[h[1]]))
         d = carried - h[5]
         return bool(
-            np.hypot(d[0], d[1]) <= p.loop_consistency
-            and abs(np.degrees(np.angle(np.exp(1j * d[2])))) <= p.loop_consistency_deg
+            np.hypot(d[0], d[1]) <= dist and abs(np.degrees(np.angle(np.exp(1j * d[2])))) <= deg
         )
 
     def _optimize(self) -> None:

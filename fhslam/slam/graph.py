@@ -307,7 +307,7 @@ class GraphSlamParams:
         hit an old map that may be bent between the places they hit, with queries the
         tracker may have bent; the Freiburg hospital's right confirmations at its return
         after 900 m lie up to 0.22 m and 1.5 degrees apart, its other confirmations within
-        0.06 m and 0.4 degrees, and a wrong match is metres away (the ``ring``'s period
+        0.06 m and 0.5 degrees, and a wrong match is metres away (the ``ring``'s period
         of 10 m, the ``campus``'s crossing of 2.5 m). Until stop 40 the local closures' 0.15 m
         and 2 degrees: the hospital's dropped-scans seed 9 with ``smooth_clouds`` (0.159
         m) and dropped scans and noise seed 0 likewise (0.186 m) missed their return.

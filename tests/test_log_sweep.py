@@ -158,9 +158,9 @@ def test_the_simulated_sweep_takes_graph_parameters_too(monkeypatch, capsys):
     seen = {}
     monkeypatch.setattr(compare, "slam_sweep", lambda **kw: seen.update(kw) or [])
     monkeypatch.setattr(compare, "format_summary", lambda rows: "")
-    assert main(["sweep", "--world", "hall", "--set", "smooth_clouds=true", "--quiet"]) == 0
-    assert capsys.readouterr().out.startswith("the graph method with --set smooth_clouds=true")
-    assert seen["params"] == GraphSlamParams(smooth_clouds=True)
+    assert main(["sweep", "--world", "hall", "--set", "smooth_clouds=false", "--quiet"]) == 0
+    assert capsys.readouterr().out.startswith("the graph method with --set smooth_clouds=false")
+    assert seen["params"] == GraphSlamParams(smooth_clouds=False)
     assert seen["methods"] == ["fht", "graph", "classical", "ekf", "odometry"]
     assert (seen["world"], seen["levels"], seen["degrade_seed"]) == (
         "hall",

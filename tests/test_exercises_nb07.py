@@ -57,7 +57,7 @@ def right_stats(rows, method, level):
 
 def test_lowest_ate_on_the_committed_sweep_is_the_ekf(sweep):
     ok = check_lowest_ate("d", sweep)
-    assert ok and "EKF line SLAM 2.3 cm, FH-SLAM graph 3.5 cm" in ok.message
+    assert ok and "EKF line SLAM 2.3 cm, FH-SLAM graph 2.4 cm" in ok.message
     assert "FH-SLAM (paper) 5.6 cm" in ok.message and "odometry 2.69 m" in ok.message
     fht = check_lowest_ate("a", sweep)
     assert fht.status == "wrong" and "5.6 cm" in fht.message and "Loop 3" in fht.message
@@ -65,10 +65,13 @@ def test_lowest_ate_on_the_committed_sweep_is_the_ekf(sweep):
     for letter in "bce":
         assert check_lowest_ate(letter, sweep).status == "wrong"
     assert check_lowest_ate(" (D) ", sweep)
-    # the margin: the EKF's median is far below the next one's
+    # the margin: the EKF's median is far below the paper's procedure's (the claim the
+    # exercise is about) and the odometry's; the graph method's, since stop 43's defaults,
+    # comes close (2.28 against 2.43 cm)
     s = summary(sweep)
-    others = [s[("high", m)]["ate_median"] for m in ("fht", "graph", "classical", "odometry")]
+    others = [s[("high", m)]["ate_median"] for m in ("fht", "classical", "odometry")]
     assert s[("high", "ekf")]["ate_median"] < 0.7 * min(others)
+    assert s[("high", "ekf")]["ate_median"] < s[("high", "graph")]["ate_median"]
 
 
 def test_lowest_ate_is_computed_from_the_rows_and_the_level():

@@ -197,6 +197,40 @@ def smooth_scan(
     if n < 2 * h + 1:
         return out
     inner = np.arange(h, n - h)
+    own = nrm[inner]
+    cos = np.cos(np.radians(max_turn_deg))
+    # the window means, the turn tests and the spreads across, compiled (stop 43: 0.29 ms
+    # a scan in NumPy, most of the cost of smoothing every scan); bit for bit the NumPy
+    # reference's, _smooth_scan_numpy (tests/test_kernels.py)
+    mean, ok, rms = _smooth_windows(p, np.ascontiguousarray(nrm), h, cos)
+    if not ok.any():
+        return out
+    ok &= rms <= max_spread * np.median(rms[ok])
+    k = inner[ok]
+    off = ((p[k] - mean[ok]) * own[ok]).sum(1)
+    out[k] -= off[:, None] * own[ok]
+    return out
+
+
+def _smooth_scan_numpy(
+    points: ArrayLike,
+    normals: ArrayLike,
+    half_window: int = 3,
+    max_turn_deg: float = 10.0,
+    max_spread: float = 2.0,
+) -> NDArray[np.float64]:
+    """The NumPy reference of :func:`smooth_scan` (tests/test_kernels.py)."""
+    p = as_points(points, "points")
+    nrm = np.asarray(normals, dtype=float).reshape(-1, 2)
+    if len(nrm) != len(p):
+        raise ValueError(f"{len(nrm)} normals for {len(p)} points")
+    if half_window < 1:
+        raise ValueError(f"half_window must be >= 1, got {half_window}")
+    h, n = half_window, len(p)
+    out = p.copy()
+    if n < 2 * h + 1:
+        return out
+    inner = np.arange(h, n - h)
     window = np.lib.stride_tricks.sliding_window_view(p, 2 * h + 1, axis=0)  # (m, 2, w)
     mean = window.mean(axis=2)
     own, before, after = nrm[inner], nrm[inner - h], nrm[inner + h]
@@ -212,6 +246,48 @@ def smooth_scan(
     off = ((p[k] - mean[ok]) * own[ok]).sum(1)
     out[k] -= off[:, None] * own[ok]
     return out
+
+
+@njit(cache=True, nogil=True)
+def _smooth_windows(p, nrm, h, cos):  # pragma: no cover
+    """For :func:`smooth_scan`, each window of ``2 h + 1`` points: its mean, whether its
+    normals pass the turn tests, and the rms of its points across the middle normal; the
+    operations of :func:`_smooth_scan_numpy` in its order (sums from +0.0, one term after
+    the other, as NumPy sums fewer than 8 values; NaN normals fail the tests, and count
+    as 0 across)."""
+    w = 2 * h + 1
+    m = p.shape[0] - w + 1
+    mean = np.empty((m, 2))
+    ok = np.empty(m, np.bool_)
+    rms = np.empty(m)
+    for i in range(m):
+        sx = 0.0
+        sy = 0.0
+        for j in range(w):
+            sx += p[i + j, 0]
+            sy += p[i + j, 1]
+        mx = sx / w
+        my = sy / w
+        mean[i, 0] = mx
+        mean[i, 1] = my
+        k = i + h
+        ox, oy = nrm[k, 0], nrm[k, 1]
+        tb = 0.0 + ox * nrm[k - h, 0]
+        tb += oy * nrm[k - h, 1]
+        ta = 0.0 + ox * nrm[k + h, 0]
+        ta += oy * nrm[k + h, 1]
+        ok[i] = (abs(tb) >= cos) and (abs(ta) >= cos)
+        if ox != ox:  # NaN: np.nan_to_num
+            ox = 0.0
+        if oy != oy:
+            oy = 0.0
+        s2 = 0.0
+        for j in range(w):
+            a = 0.0 + (p[i + j, 0] - mx) * ox
+            a += (p[i + j, 1] - my) * oy
+            s2 += a * a
+        rms[i] = np.sqrt(s2 / w)
+    return mean, ok, rms
 
 
 @njit(cache=True, nogil=True)
@@ -712,6 +788,7 @@ def match_clouds(
     prior: tuple[float, float] = (0.05, 0.05),
     exclude: tuple[float, float] | None = None,
     min_coarse: float = -np.inf,
+    exclude_min_score: float = -np.inf,
 ) -> MatchResult:
     """The pose of the ``query`` cloud's frame in the ``target`` cloud's frame.
 
@@ -750,6 +827,11 @@ def match_clouds(
         window). The coarse grid's wider likelihood scores a pose about as high as the fine
         grid or higher, so a floor at the fine score wanted should lose little (the Freiburg
         hospital's global matches are the same with and without it).
+    exclude_min_score : float
+        With ``exclude``: look for the runner-up only if the (fine) score reaches this;
+        otherwise ``runner_up`` is 0. A caller that drops matches under a score anyway
+        saves the second coarse search for them (most loop searches fail); where it is
+        looked for, the runner-up is the same as without this.
 
     Returns
     -------
@@ -763,7 +845,8 @@ def match_clouds(
     (rc, sc, ac), (rf, sf, af) = coarse, fine
     if len(q) < 10:
         return MatchResult(g, 0.0, 0.0)
-    s_c = s_g = s_r = 0.0
+    s_c = s_g = 0.0
+    rival = None  # where exclude's runner-up is looked for: (coarse grid, points, guess, search)
     if window > 0:
         near = _crop(tg, q, g, window + 3 * sc)
         if len(near) < 10:
@@ -776,20 +859,28 @@ def match_clouds(
         if s_c == 0.0 and min_coarse > -np.inf:
             return MatchResult(g, 0.0, 0.0, s_g)  # nothing above the floor
         if exclude is not None:
-            s_r = correlative_search(
-                grid, qc, g, *search, exclude=(best, exclude[0]), floor=exclude[1] * s_c
-            )[0]
+            rival = (grid, qc, g, search)
         g = best
+
+    def runner_up(score: float) -> float:
+        """The runner-up's coarse score, looked for once the match is worth it."""
+        if rival is None or not score >= exclude_min_score:
+            return 0.0
+        grid_c, points, guess_c, search_c = rival
+        return correlative_search(
+            grid_c, points, guess_c, *search_c, exclude=(best, exclude[0]), floor=exclude[1] * s_c
+        )[0]
+
     qf = _thin(voxel_downsample(q, 1.5 * rf), max_points[1])
     fw = 6 * rf
     near = _crop(tg, q, g, fw + 3 * sf)
     if len(near) < 10:
-        return MatchResult(g, 0.0, s_c, s_g, s_r)
+        return MatchResult(g, 0.0, s_c, s_g, runner_up(0.0))
     grid = LikelihoodGrid.build(near, rf, sf, fw + 3 * sf)
     s_f, pose = correlative_search(
         grid, qf, g, fw, np.radians(ac if window > 0 else window_deg), np.radians(af), prior
     )
-    return MatchResult(pose, s_f, s_c, s_g, s_r)
+    return MatchResult(pose, s_f, s_c, s_g, runner_up(s_f))
 
 
 def densify(

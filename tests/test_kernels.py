@@ -33,10 +33,12 @@ from fhslam.scanmatch import (
     _scan_normals_numpy,
     _search,
     _search_padded,
+    _smooth_scan_numpy,
     _voxel_index_numpy,
     densify,
     refine,
     scan_normals,
+    smooth_scan,
     voxel_index,
 )
 from fhslam.sim import load_world, simulate
@@ -189,6 +191,33 @@ def test_scan_normals_equal_numpy_bit_for_bit(half_window, paper_scans):
     if half_window > 0:  # not vacuous: real scans have normals and NaNs both
         n = scan_normals(paper_scans[0], half_window)
         assert np.isnan(n[:, 0]).any() and np.isfinite(n[:, 0]).sum() > 50
+
+
+@pytest.mark.parametrize("half_window", [1, 2, 3, 4])
+def test_smooth_scan_equals_numpy_bit_for_bit(half_window, paper_scans):
+    """:func:`smooth_scan` (the window sums, turn tests and spreads compiled, stop 43)
+    equals :func:`_smooth_scan_numpy` bit for bit: real scans (the paper world's and a noisy
+    walk along walls with corners), NaN normals, identical points, windows that fail every
+    test, and scans shorter than, equal to and one longer than the window."""
+    rng = np.random.default_rng(7)
+    w = 2 * half_window + 1
+    walk = np.cumsum(rng.normal(0, 0.03, (300, 2)), axis=0) + np.array([2.0, 0.0])
+    walk[::37] += 0.8
+    t = np.linspace(0.0, 1.0, 120)
+    room = np.vstack(
+        [np.column_stack([t, np.zeros_like(t)]), np.column_stack([np.ones_like(t), t])]
+    )
+    room += rng.normal(0, 0.01, room.shape)
+    scans = [*paper_scans, walk, room, np.repeat(walk[:60], 2, axis=0), np.zeros((12, 2))]
+    scans += [walk[: w - 1], walk[:w], walk[: w + 1]]
+    smoothed = 0
+    for p in scans:
+        nrm = scan_normals(p, half_window) if len(p) else np.zeros((0, 2))
+        for kw in ({}, {"max_turn_deg": 30.0, "max_spread": 1.0}, {"max_turn_deg": 0.0}):
+            got = smooth_scan(p, nrm, half_window, **kw)
+            assert_identical(got, _smooth_scan_numpy(p, nrm, half_window, **kw))
+            smoothed += int((got != p).any())
+    assert smoothed > len(paper_scans)  # not vacuous: most scans have points moved
 
 
 @pytest.mark.parametrize(("half_window", "y"), [(1, 0.1), (2, 0.11), (3, 0.7)])

@@ -319,6 +319,28 @@ def test_a_match_in_a_repeating_corridor_has_a_runner_up_as_good():
     assert match_clouds(room, room, [0.3, 0.1, 0.0], window=3.0).runner_up == 0.0
 
 
+def test_the_runner_up_is_looked_for_only_for_a_match_worth_it():
+    """``exclude_min_score``: the runner-up is the same where the fine score reaches it, and
+    0 (not looked for) where it does not; the pose and the scores are the same either way."""
+    x = np.arange(0.0, 20.0, 0.02)
+    walls = np.vstack([np.column_stack([x, np.full_like(x, y)]) for y in (0.0, 3.0)])
+    t = np.linspace(0, 2 * np.pi, 32, endpoint=False)
+    pillars = np.vstack(
+        [np.column_stack([cx + 0.2 * np.cos(t), 1.5 + 0.2 * np.sin(t)]) for cx in range(1, 20, 2)]
+    )
+    corridor = np.vstack([walls, pillars])
+    query = corridor[(corridor[:, 0] > 6.5) & (corridor[:, 0] < 13.5)]
+    args = (corridor, query, [0.3, 0.1, 0.0])
+    always = match_clouds(*args, window=3.0, exclude=(1.0, 0.9))
+    assert always.runner_up > 0 and always.score > 0.5  # measured 1.0 and 1.0
+    worth = match_clouds(*args, window=3.0, exclude=(1.0, 0.9), exclude_min_score=0.5)
+    assert worth.runner_up == always.runner_up
+    not_worth = match_clouds(*args, window=3.0, exclude=(1.0, 0.9), exclude_min_score=1.01)
+    assert not_worth.runner_up == 0.0
+    np.testing.assert_array_equal(not_worth.pose, always.pose)
+    assert (not_worth.score, not_worth.coarse_score) == (always.score, always.coarse_score)
+
+
 def test_a_search_with_a_floor_looks_only_above_it():
     """``floor``: the same optimum when it lies above the floor, ``(0, guess)`` when
     nothing does."""

@@ -910,6 +910,7 @@ class GraphFastHoughSLAM:
             m = match_clouds(
                 target, query, relative(poses[j], poses[i]), win, win_deg,
                 exclude=(p.loop_unique_radius, p.global_max_ambiguity) if unique else None,
+                exclude_min_score=p.loop_min_score,
             )  # fmt: skip
             if m.score < p.loop_min_score:
                 self._failed[j] = i

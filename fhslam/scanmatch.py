@@ -186,6 +186,23 @@ def smooth_scan(
     the noise that moves them off it (1 cm in the simulated laser), which a keyframe cloud
     otherwise carries into every scan matched against it.
     """
+    return _smooth(points, normals, half_window, max_turn_deg, max_spread, _smooth_windows)
+
+
+def _smooth_scan_numpy(
+    points: ArrayLike,
+    normals: ArrayLike,
+    half_window: int = 3,
+    max_turn_deg: float = 10.0,
+    max_spread: float = 2.0,
+) -> NDArray[np.float64]:
+    """The NumPy reference of :func:`smooth_scan` (tests/test_kernels.py)."""
+    return _smooth(points, normals, half_window, max_turn_deg, max_spread, _smooth_windows_numpy)
+
+
+def _smooth(points, normals, half_window, max_turn_deg, max_spread, windows):
+    """:func:`smooth_scan` with ``windows(p, normals, h, cos)`` giving each window's mean,
+    whether it passes the turn tests and its rms across (compiled, or NumPy's)."""
     p = as_points(points, "points")
     nrm = np.asarray(normals, dtype=float).reshape(-1, 2)
     if len(nrm) != len(p):
@@ -198,11 +215,7 @@ def smooth_scan(
         return out
     inner = np.arange(h, n - h)
     own = nrm[inner]
-    cos = np.cos(np.radians(max_turn_deg))
-    # the window means, the turn tests and the spreads across, compiled (stop 43: 0.29 ms
-    # a scan in NumPy, most of the cost of smoothing every scan); bit for bit the NumPy
-    # reference's, _smooth_scan_numpy (tests/test_kernels.py)
-    mean, ok, rms = _smooth_windows(p, np.ascontiguousarray(nrm), h, cos)
+    mean, ok, rms = windows(p, np.ascontiguousarray(nrm), h, np.cos(np.radians(max_turn_deg)))
     if not ok.any():
         return out
     ok &= rms <= max_spread * np.median(rms[ok])
@@ -212,47 +225,24 @@ def smooth_scan(
     return out
 
 
-def _smooth_scan_numpy(
-    points: ArrayLike,
-    normals: ArrayLike,
-    half_window: int = 3,
-    max_turn_deg: float = 10.0,
-    max_spread: float = 2.0,
-) -> NDArray[np.float64]:
-    """The NumPy reference of :func:`smooth_scan` (tests/test_kernels.py)."""
-    p = as_points(points, "points")
-    nrm = np.asarray(normals, dtype=float).reshape(-1, 2)
-    if len(nrm) != len(p):
-        raise ValueError(f"{len(nrm)} normals for {len(p)} points")
-    if half_window < 1:
-        raise ValueError(f"half_window must be >= 1, got {half_window}")
-    h, n = half_window, len(p)
-    out = p.copy()
-    if n < 2 * h + 1:
-        return out
-    inner = np.arange(h, n - h)
+def _smooth_windows_numpy(p, nrm, h, cos):
+    """:func:`_smooth_windows` in NumPy: the reference its operations follow."""
+    inner = np.arange(h, len(p) - h)
     window = np.lib.stride_tricks.sliding_window_view(p, 2 * h + 1, axis=0)  # (m, 2, w)
     mean = window.mean(axis=2)
     own, before, after = nrm[inner], nrm[inner - h], nrm[inner + h]
-    cos = np.cos(np.radians(max_turn_deg))
     with np.errstate(invalid="ignore"):  # NaN normals compare False
         ok = (np.abs((own * before).sum(1)) >= cos) & (np.abs((own * after).sum(1)) >= cos)
-    if not ok.any():
-        return out
     across = ((window - mean[:, :, None]) * np.nan_to_num(own)[:, :, None]).sum(axis=1)
-    rms = np.sqrt((across**2).mean(axis=1))
-    ok &= rms <= max_spread * np.median(rms[ok])
-    k = inner[ok]
-    off = ((p[k] - mean[ok]) * own[ok]).sum(1)
-    out[k] -= off[:, None] * own[ok]
-    return out
+    return mean, ok, np.sqrt((across**2).mean(axis=1))
 
 
 @njit(cache=True, nogil=True)
 def _smooth_windows(p, nrm, h, cos):  # pragma: no cover
     """For :func:`smooth_scan`, each window of ``2 h + 1`` points: its mean, whether its
-    normals pass the turn tests, and the rms of its points across the middle normal; the
-    operations of :func:`_smooth_scan_numpy` in its order (sums from +0.0, one term after
+    normals pass the turn tests, and the rms of its points across the middle normal (0.31
+    ms a scan in NumPy, 0.08 ms in all compiled; stop 43); the operations of
+    :func:`_smooth_windows_numpy` in its order (sums from +0.0, one term after
     the other, as NumPy sums fewer than 8 values; NaN normals fail the tests, and count
     as 0 across)."""
     w = 2 * h + 1

@@ -295,11 +295,8 @@ def test_a_search_can_leave_out_the_positions_near_a_pose(n_t):
     assert score < best_score
 
 
-def test_a_match_in_a_repeating_corridor_has_a_runner_up_as_good():
-    """``match_clouds(..., exclude=(r, f))`` reports the best coarse score more than ``r``
-    from the coarse optimum if it is above ``f`` of the coarse score: in a corridor with a
-    pillar every 2 m a query seeing four pillars matches one pillar further as well; in the
-    room with its box, nothing else comes close."""
+def _pillared_corridor():
+    """A corridor 3 m wide with a pillar every 2 m, and a query seeing four pillars of it."""
     x = np.arange(0.0, 20.0, 0.02)
     walls = np.vstack([np.column_stack([x, np.full_like(x, y)]) for y in (0.0, 3.0)])
     t = np.linspace(0, 2 * np.pi, 32, endpoint=False)
@@ -307,7 +304,15 @@ def test_a_match_in_a_repeating_corridor_has_a_runner_up_as_good():
         [np.column_stack([cx + 0.2 * np.cos(t), 1.5 + 0.2 * np.sin(t)]) for cx in range(1, 20, 2)]
     )
     corridor = np.vstack([walls, pillars])
-    query = corridor[(corridor[:, 0] > 6.5) & (corridor[:, 0] < 13.5)]
+    return corridor, corridor[(corridor[:, 0] > 6.5) & (corridor[:, 0] < 13.5)]
+
+
+def test_a_match_in_a_repeating_corridor_has_a_runner_up_as_good():
+    """``match_clouds(..., exclude=(r, f))`` reports the best coarse score more than ``r``
+    from the coarse optimum if it is above ``f`` of the coarse score: in a corridor with a
+    pillar every 2 m a query seeing four pillars matches one pillar further as well; in the
+    room with its box, nothing else comes close."""
+    corridor, query = _pillared_corridor()
     m = match_clouds(corridor, query, [0.3, 0.1, 0.0], window=3.0, exclude=(1.0, 0.9))
     assert m.runner_up >= 0.9 * m.coarse_score  # measured 1.0 and 1.0
     room = _room()
@@ -322,14 +327,7 @@ def test_a_match_in_a_repeating_corridor_has_a_runner_up_as_good():
 def test_the_runner_up_is_looked_for_only_for_a_match_worth_it():
     """``exclude_min_score``: the runner-up is the same where the fine score reaches it, and
     0 (not looked for) where it does not; the pose and the scores are the same either way."""
-    x = np.arange(0.0, 20.0, 0.02)
-    walls = np.vstack([np.column_stack([x, np.full_like(x, y)]) for y in (0.0, 3.0)])
-    t = np.linspace(0, 2 * np.pi, 32, endpoint=False)
-    pillars = np.vstack(
-        [np.column_stack([cx + 0.2 * np.cos(t), 1.5 + 0.2 * np.sin(t)]) for cx in range(1, 20, 2)]
-    )
-    corridor = np.vstack([walls, pillars])
-    query = corridor[(corridor[:, 0] > 6.5) & (corridor[:, 0] < 13.5)]
+    corridor, query = _pillared_corridor()
     args = (corridor, query, [0.3, 0.1, 0.0])
     always = match_clouds(*args, window=3.0, exclude=(1.0, 0.9))
     assert always.runner_up > 0 and always.score > 0.5  # measured 1.0 and 1.0

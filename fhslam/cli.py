@@ -397,7 +397,7 @@ def _graph_params(pairs: list[str]):
     for pair in pairs:
         name, sep, text = (x.strip() for x in pair.partition("="))
         if not sep or not name or not text:
-            raise InputError(f"--set {pair!r}: expected NAME=VALUE, e.g. loop_target_keyframes=6")
+            raise InputError(f"--set {pair!r}: expected NAME=VALUE, e.g. loop_target_keyframes=4")
         kind = kinds.get(name)
         if kind not in ("bool", "int", "float"):
             raise InputError(
@@ -702,7 +702,7 @@ def build_parser() -> argparse.ArgumentParser:
         metavar="NAME=VALUE",
         help="--method graph: set a number or switch of fhslam.slam.GraphSlamParams, or as "
         "tracker.NAME of its scan tracker's TrackerParams (repeat for more), e.g. --set "
-        "loop_target_keyframes=6 --set tracker.window=0.3; the trajectory's header records it",
+        "loop_target_keyframes=4 --set tracker.window=0.3; the trajectory's header records it",
     )
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.add_argument("--profile", action="store_true", help=PROFILE_HELP)

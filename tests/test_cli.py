@@ -908,12 +908,12 @@ def test_slam_set_runs_the_graph_method_with_those_parameters(short_clf, tmp_pat
     from fhslam.slam import GraphSlamParams
 
     out = tmp_path / "t.txt"
-    sets = ["--set", "smooth_clouds=false", "--set", "loop_target_keyframes = 6"]
+    sets = ["--set", "smooth_clouds=false", "--set", "loop_target_keyframes = 3"]
     assert main(["slam", str(short_clf), "--trajectory", str(out), "--quiet", *sets]) == 0
     header = out.read_text().splitlines()[0]
-    assert "--set smooth_clouds=false --set loop_target_keyframes = 6" in header
+    assert "--set smooth_clouds=false --set loop_target_keyframes = 3" in header
     log = read_carmen(short_clf)
-    expected = run_slam(log, params=GraphSlamParams(smooth_clouds=False, loop_target_keyframes=6))
+    expected = run_slam(log, params=GraphSlamParams(smooth_clouds=False, loop_target_keyframes=3))
     t, poses = read_trajectory(out)
     np.testing.assert_array_equal(t, expected.timestamps)
     np.testing.assert_allclose(poses, expected.poses, atol=1e-9)  # the file's 9+ digits

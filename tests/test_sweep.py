@@ -31,8 +31,10 @@ def runs():
 #: a discrete choice that flips with the last bit (scan 33 of seed 0) grows to centimetres
 #: there. Seed 0 with the odometry multiplied by (1 + 1e-15 ε), 8 draws each (README,
 #: "robustness"): low 0.040-0.066 m, medium 0.051-0.080 m; the committed medium row (0.043 m,
-#: another machine) and this machine's unperturbed run (0.080 m) lie at the two ends. So a
-#: graph row is only checked to lie within that spread of a run now: 0.045 m.
+#: another machine) and this machine's unperturbed run (0.080 m) lay at the two ends. So a
+#: graph row is only checked to lie within that spread of a run now: 0.045 m. At stop 44:
+#: low 0.010-0.065 m, medium 0.014-0.021 m (unperturbed 0.019 and 0.017 m; the committed rows,
+#: stop 43's defaults on this machine, 0.026 and 0.022 m).
 ATE_TOLERANCE = {"graph": 0.045}
 
 
@@ -164,8 +166,8 @@ def test_the_graph_methods_settings_are_recorded_row_by_row(tmp_path):
     from fhslam.slam import GraphSlamParams
     from fhslam.slam.tracker import TrackerParams
 
-    params = GraphSlamParams(loop_target_keyframes=6, tracker=TrackerParams(window=0.3))
-    assert settings_text(params) == "tracker.window=0.3 loop_target_keyframes=6"
+    params = GraphSlamParams(loop_target_keyframes=4, tracker=TrackerParams(window=0.3))
+    assert settings_text(params) == "tracker.window=0.3 loop_target_keyframes=4"
     assert settings_text(GraphSlamParams()) == settings_text(None) == ""
     rows = slam_sweep(
         "corridor", seeds=[0], levels=["low"], methods=["odometry", "graph"], n_jobs=1,
@@ -173,7 +175,7 @@ def test_the_graph_methods_settings_are_recorded_row_by_row(tmp_path):
     )  # fmt: skip
     assert [(r.method, r.settings) for r in rows] == [
         ("odometry", ""),
-        ("graph", "tracker.window=0.3 loop_target_keyframes=6"),
+        ("graph", "tracker.window=0.3 loop_target_keyframes=4"),
     ]
     save_sweep(rows, tmp_path / "s.csv")
     assert tmp_path.joinpath("s.csv").read_text().splitlines()[0].endswith(",last_bit,settings")

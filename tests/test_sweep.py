@@ -33,8 +33,8 @@ def runs():
 #: "robustness"): low 0.040-0.066 m, medium 0.051-0.080 m; the committed medium row (0.043 m,
 #: another machine) and this machine's unperturbed run (0.080 m) lay at the two ends. So a
 #: graph row is only checked to lie within that spread of a run now: 0.045 m. At stop 44:
-#: low 0.010-0.065 m, medium 0.014-0.021 m (unperturbed 0.019 and 0.017 m; the committed rows,
-#: stop 43's defaults on this machine, 0.026 and 0.022 m).
+#: low 0.010-0.065 m, medium 0.014-0.021 m (unperturbed 0.019 and 0.017 m, as the committed
+#: rows have them).
 ATE_TOLERANCE = {"graph": 0.045}
 
 

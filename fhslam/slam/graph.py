@@ -168,9 +168,9 @@ class GraphSlamParams:
         against 0.55 at the true pose) and every later closure inherited the shift. With
         ± 6 (stop 44; the default since then), seeds 0-4 give 0.33, 0.46, 0.47, 5.64 and
         0.45 m (± 3: 7.78, 0.38, 7.60, 6.83, 0.34 m): not a cure, both hypotheses can
-        still score alike. The Freiburg hospital's 30 runs with noise or dropped scans all
-        stay within issue 10's bound (as with ± 3; at stop 35, before the global search's
-        consistency test, ± 6 failed 6 of them), the README's 120-run yardstick comes to a
+        still score alike. The Freiburg hospital's 32 perturbed runs (noise, dropped scans,
+        both) all stay within issue 10's bound (as with ± 3; at stop 35, before the global
+        search's consistency test, ± 6 failed 6 of 33), the README's 120-run yardstick comes to a
         mean of 1.05 cm with 2 runs over 3 cm (± 3: 1.11 cm, 5), and the shared logs
         within 1 %.
     loop_candidates : int

@@ -500,12 +500,16 @@ print(check_span_reading("b"))
 # %% [markdown]
 # ## 6 · Run time
 #
-# Measured with `/usr/bin/time` when the files of section 2 were made: one process each, on this
-# 2-core machine, which is shared with other jobs, so the seconds vary from run to run (the same
-# commands took two to three times as long another time, with more jobs running). The log
-# itself lasts 2691.3 s: the graph method ran about 160× faster than real time (the whole command,
+# Measured with `/usr/bin/time` on the commands of section 2 (2026-11-29, with the defaults that
+# made the files): one process each, twice, on this 2-core machine, which is shared with other
+# jobs, so the seconds vary from run to run (the second runs took 10-30 % longer: Intel's graph
+# run 38.3 s, the paper's procedure 73.3 s); the table gives the faster run. When the files were
+# first made the same two commands took 16.0 and 30.1 s: the paper's procedure has not changed
+# since, so most of the difference is the machine's day (`fhslam bench` gives ratios to a
+# reference call timed in the same run, which hold across such days). The log itself
+# lasts 2691.3 s: the graph method ran about 80× faster than real time (the whole command,
 # reading the bag and the imports included; `fhslam bench --log intel` times the run alone), the
-# paper's procedure about 90×. Hess et al. 2016 report 179 s of wall-clock time for Cartographer on
+# paper's procedure about 40×. Hess et al. 2016 report 179 s of wall-clock time for Cartographer on
 # Intel — on a different machine, so the numbers below are not a comparison — i.e. about 15× real
 # time. `fhslam bench --log intel` shows where the graph method's time goes.
 
@@ -522,8 +526,8 @@ def timing_table(log, seconds):
 timing_table(
     log,
     {
-        'FH-SLAM (paper, "fht")': 30.1,
-        'FH-SLAM graph ("graph")': 16.0,
+        'FH-SLAM (paper, "fht")': 66.5,
+        'FH-SLAM graph ("graph")': 33.2,
         "Cartographer (Hess 2016, reported)": 179.0,
     },
 )
@@ -591,18 +595,18 @@ span_summary(res_mit, t1_mit, t2_mit, rel_mit)
 # The graph method brings mit-csail, with the same defaults as Intel, to 0.027 ± 0.022 m and 0.34°
 # over all relations, against 0.77 m for the paper's procedure and 1.68 m for the raw odometry —
 # 0.025 m below 5 s (0.044 m for the paper's procedure), 0.044 m between 5 s and a minute (2.1 m;
-# only 27 relations) and 0.040 m over more than a minute (7.9 m). Of its 233 accepted loop
-# closures 232 stay active (one is switched off as inconsistent). The run took 5.0 s on this machine, about 85× faster than real time (the
-# table below). This log is where the method was least robust: before closures that move a
-# keyframe far had to wait for an independent one, a relative change of 1e-15 in the odometry
-# could decide a few loop closures differently and cost decimetres; `tests/test_graphslam.py` now
-# checks that such last-bit noise leaves it at a few centimetres.
+# only 27 relations) and 0.040 m over more than a minute (7.9 m). Of its 233 accepted loop closures
+# 232 stay active (one is switched off as inconsistent). The run took 10.8 s on this machine, about
+# 39× faster than real time (the table below). This log is where the method was least robust: before
+# closures that move a keyframe far had to wait for an independent one, a relative change of 1e-15
+# in the odometry could decide a few loop closures differently and cost decimetres;
+# `tests/test_graphslam.py` now checks that such last-bit noise leaves it at a few centimetres.
 
 # %% tags=["nbval-ignore-output"]
 # wall-clock seconds of the commands of section 2 with mit-csail (/usr/bin/time)
 timing_table(
     log_mit,
-    {'FH-SLAM (paper, "fht")': 4.9, 'FH-SLAM graph ("graph")': 5.0},
+    {'FH-SLAM (paper, "fht")': 9.3, 'FH-SLAM graph ("graph")': 10.8},
 )
 
 # %% [markdown]

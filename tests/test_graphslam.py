@@ -124,7 +124,7 @@ def test_a_repeated_unique_closure_confirms_itself_only_with_loop_repeat_confirm
 
 def test_loop_repeat_confirm_closes_the_paper_worlds_single_return():
     """The paper world, clean, seed 0, its odometry perturbed in the last bit (seed 6): on
-    its one return to the first corridor keyframes 126-128 match keyframes 24-25, unique,
+    its one return to the first corridor keyframes 126-127 match keyframes 24-25, unique,
     11.6 cm from the estimate, and no independent closure comes to confirm them. By default
     they lapse (ATE 6.48 cm on this machine: the draw is decided by that threshold); with
     ``loop_repeat_confirm`` 0.02 two of them confirm each other and the return is closed."""

@@ -263,7 +263,7 @@ class GraphSlamParams:
         (:meth:`GraphFastHoughSLAM._confirms`). On a single return to a place no
         independent closure comes, and the held ones lapse: the paper world, clean, seed 0,
         odometry perturbed in its last bit (seed 6), comes back to its first corridor with
-        keyframes 126-128 matching 24-25 unique and 11.6 cm from its estimate, and ends at
+        keyframes 126-127 matching 24-25 unique and 11.6 cm from its estimate, and ends at
         an ATE of 6.48 cm; with 0.02 the first two confirm each other (0.9 mm, 0.12 degrees
         apart) and it ends at 1.51 cm. Without the bound on the move, wrong matches that
         repeat as alike confirm each other: the ``ring``'s a corridor's width off (seeds

@@ -940,19 +940,20 @@ class GraphFastHoughSLAM:
             if c is None:
                 continue
             move = c[5] - poses[i]  # how far the closure moves keyframe i
+            shift, ambiguous = float(np.hypot(move[0], move[1])), bool(m.runner_up > 0)
             if not tracking and (
-                m.runner_up > 0  # not unique (loop_unique_radius)
-                or np.hypot(move[0], move[1]) > p.loop_confirm_distance
+                ambiguous  # not unique (loop_unique_radius)
+                or shift > p.loop_confirm_distance
                 or abs(np.degrees(np.angle(np.exp(1j * move[2])))) > p.loop_confirm_deg
             ):
-                held.append((*c, m.runner_up > 0, float(np.hypot(move[0], move[1]))))
+                held.append((*c, ambiguous, shift))
                 continue
             closed.append(self._add_loop(*c[:5]))
         if closed:
             self._pending = []  # the estimate is confirmed as it stands
         self._pending = [h for h in self._pending if i - h[1] <= p.loop_confirm_window]
         for h in held:
-            # from a query that shares no keyframe with this one (queries span 3 keyframes)
+            # an independent one that agrees (or, with loop_repeat_confirm, a repeat)
             support = [g for g in self._pending if self._confirms(g, h, poses)]
             if support:
                 for g in [*support, h]:

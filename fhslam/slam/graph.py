@@ -255,21 +255,20 @@ class GraphSlamParams:
     loop_confirm_window : int
         See ``loop_confirm_deg``.
     loop_repeat_confirm : float
-        0 (the default) leaves this out. Above 0, a held closure whose match is unique (see
-        ``loop_unique_radius``) and that moves its keyframe by at most three times
-        ``loop_confirm_distance`` is also confirmed by another such closure from another
-        keyframe's query, against the same target or not, when the two place the keyframe
-        within this many metres and 0.5 degrees of each other
+        0 leaves this out. Above 0 (0.02, the default since stop 46), a held closure whose
+        match is unique (see ``loop_unique_radius``) and that moves its keyframe by at most
+        three times ``loop_confirm_distance`` is also confirmed by another such closure from
+        another keyframe's query, against the same target or not, when the two place the
+        keyframe within this many metres and 0.5 degrees of each other
         (:meth:`GraphFastHoughSLAM._confirms`). On a single return to a place no
         independent closure comes, and the held ones lapse: the paper world, clean, seed 0,
         odometry perturbed in its last bit (seed 6), comes back to its first corridor with
-        keyframes 126-127 matching 24-25 unique and 11.6 cm from its estimate, and ends at
-        an ATE of 6.48 cm; with 0.02 the first two confirm each other (0.9 mm, 0.12 degrees
+        keyframes 126-127 matching 24-25 unique and 11.6 cm from its estimate, and with 0 ends
+        at an ATE of 6.48 cm; with 0.02 the first two confirm each other (0.9 mm, 0.12 degrees
         apart) and it ends at 1.51 cm. Without the bound on the move, wrong matches that
         repeat as alike confirm each other: the ``ring``'s a corridor's width off (seeds
         0-3: 2.99-3.16 m instead of 0.10-0.12) and the ``campus``'s 2.5 m off (seed 2:
-        0.47 -> 6.87 m). Stop 45; measured, not the default yet (README, *Not solved: long
-        corridors*).
+        0.47 -> 6.87 m). Stop 45 (README, *Not solved: long corridors*).
     global_every : int
         Once the robot has travelled ``global_after`` metres since the last closure, every
         this many keyframes a *global* search runs (0: never): the last
@@ -397,7 +396,7 @@ class GraphSlamParams:
     loop_consistency: float = 0.15
     loop_consistency_deg: float = 2.0
     loop_confirm_window: int = 10
-    loop_repeat_confirm: float = 0.0
+    loop_repeat_confirm: float = 0.02
     global_every: int = 20
     global_after: float = 10.0
     global_from_odometry: bool = True

@@ -89,7 +89,9 @@ def test_closures_confirm_each_other_only_when_they_share_no_keyframe():
 
 def _held(j, i, where, ambiguous=False, move=0.12):
     """A held closure as :meth:`GraphFastHoughSLAM._confirms` reads it."""
-    return (j, i, None, None, 0.7, np.asarray(where, dtype=float), ambiguous, move)
+    from fhslam.slam.graph import _HeldClosure
+
+    return _HeldClosure(j, i, None, None, 0.7, np.asarray(where, dtype=float), ambiguous, move)
 
 
 @pytest.mark.parametrize("repeat", [0.0, 0.02])
@@ -97,7 +99,8 @@ def test_a_repeated_unique_closure_confirms_itself_only_with_loop_repeat_confirm
     """Two held closures of consecutive queries against the same target are not independent.
     With ``loop_repeat_confirm`` they confirm each other if both are unique, move their
     keyframe by at most 3 × ``loop_confirm_distance`` (0.3 m), come from different queries
-    and agree within it (metres) and 0.5 degrees; never when off (the default)."""
+    and agree within it (metres) and 0.5 degrees (the default, 0.02, since stop 46); never
+    when it is 0."""
     from fhslam.geometry import compose
 
     slam = _straight_graph(GraphSlamParams(loop_repeat_confirm=repeat), n=130)

@@ -70,6 +70,7 @@ import threading
 import weakref
 from collections import OrderedDict
 from dataclasses import dataclass, field
+from typing import NamedTuple
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -488,6 +489,21 @@ class LoopClosure:
     """Its edge in :attr:`GraphFastHoughSLAM.graph`."""
 
 
+class _HeldClosure(NamedTuple):
+    """A local closure waiting for confirmation (``GraphFastHoughSLAM._confirms``): the
+    closure of ``_verified``, whether its match was ambiguous (``loop_unique_radius``) and
+    how far (metres) it moves keyframe ``i``."""
+
+    j: int
+    i: int
+    z: NDArray
+    information: NDArray
+    score: float
+    where: NDArray  # where it puts keyframe i
+    ambiguous: bool
+    shift: float
+
+
 @dataclass(eq=False)
 class _LoopTarget:
     """A loop candidate's target: the points and normals of its keyframes in its frame, and
@@ -673,8 +689,7 @@ class GraphFastHoughSLAM:
         self._path: list[float] = []  # distance travelled at each keyframe
         self._last_loop_path = 0.0
         self._doubtful = 0  # doubtful scans in a row
-        # held closures: see _confirms
-        self._pending: list[tuple[int, int, NDArray, NDArray, float, NDArray, bool, float]] = []
+        self._pending: list[_HeldClosure] = []
         self._failed: dict[int, int] = {}  # candidate -> the last keyframe it failed for
         self._hypothesis: tuple | None = None  # a global match waiting for another's support
         self._last_global = 0  # the keyframe of the last global search
@@ -945,18 +960,18 @@ class GraphFastHoughSLAM:
                 or shift > p.loop_confirm_distance
                 or abs(np.degrees(np.angle(np.exp(1j * move[2])))) > p.loop_confirm_deg
             ):
-                held.append((*c, ambiguous, shift))
+                held.append(_HeldClosure(*c, ambiguous, shift))
                 continue
             closed.append(self._add_loop(*c[:5]))
         if closed:
             self._pending = []  # the estimate is confirmed as it stands
-        self._pending = [h for h in self._pending if i - h[1] <= p.loop_confirm_window]
+        self._pending = [h for h in self._pending if i - h.i <= p.loop_confirm_window]
         for h in held:
             # an independent one that agrees (or, with loop_repeat_confirm, a repeat)
             support = [g for g in self._pending if self._confirms(g, h, poses)]
             if support:
                 for g in [*support, h]:
-                    closed.append(self._add_loop(g[0], g[1], g[2], g[3], g[4]))
+                    closed.append(self._add_loop(*g[:5]))
                 self._pending = [g for g in self._pending if not any(g is x for x in support)]
             else:
                 self._pending.append(h)
@@ -1120,21 +1135,20 @@ class GraphFastHoughSLAM:
         a, b = self._target(g[0], g[1], 3), self._target(h[0], h[1], 3)
         return abs(g[1] - h[1]) >= 3 and max(a.start, b.start) >= min(a.stop, b.stop)
 
-    def _confirms(self, g, h, poses) -> bool:
-        """Whether held closure ``g`` confirms held closure ``h`` (each ``(j, i, z,
-        information, score, where it puts keyframe i, ambiguous, how far it moves it)``):
-        independent of it and agreeing within ``loop_consistency``; or, with
-        ``loop_repeat_confirm``, both unique, neither moving its keyframe more than three
-        times ``loop_confirm_distance``, from different queries, and agreeing within
-        ``loop_repeat_confirm`` metres and 0.5 degrees."""
+    def _confirms(self, g: _HeldClosure, h: _HeldClosure, poses) -> bool:
+        """Whether held closure ``g`` confirms held closure ``h``: independent of it and
+        agreeing within ``loop_consistency``; or, with ``loop_repeat_confirm``, both unique,
+        neither moving its keyframe more than three times ``loop_confirm_distance``, from
+        different queries, and agreeing within ``loop_repeat_confirm`` metres and 0.5
+        degrees."""
         p = self.params
         if self._independent(g, h) and self._agree(g, h, poses):
             return True
         return (
             p.loop_repeat_confirm > 0
-            and not (g[6] or h[6])
-            and max(g[7], h[7]) <= 3 * p.loop_confirm_distance
-            and g[1] != h[1]
+            and not (g.ambiguous or h.ambiguous)
+            and max(g.shift, h.shift) <= 3 * p.loop_confirm_distance
+            and g.i != h.i
             and self._agree(g, h, poses, (p.loop_repeat_confirm, 0.5))
         )
 

@@ -877,3 +877,27 @@ def test_smoothed_keyframe_clouds_stop_the_heading_drift_along_a_corridor():
     assert min(off[False, 0], off[False, 1]) >= 0.7
     assert max(off[True, 0], off[True, 1]) <= 0.6
     assert off[True, 0] + off[True, 1] <= 0.5 * (off[False, 0] + off[False, 1])
+
+
+def _scale(poses, truth) -> float:
+    """The scale that, with a rotation and a translation, best maps the estimated positions
+    onto the true ones (Umeyama 1991, eq. 42): under 1 when the estimate is too large."""
+    a = poses[:, :2] - poses[:, :2].mean(axis=0)
+    b = truth[:, :2] - truth[:, :2].mean(axis=0)
+    u, s, vt = np.linalg.svd(b.T @ a / len(a))
+    d = np.diag([1.0, np.sign(np.linalg.det(u @ vt))])
+    return float(np.trace(np.diag(s) @ d) / (a**2).sum(axis=1).mean())
+
+
+def test_pair_edges_take_the_scale_out_of_the_ring():
+    """The tracker places each scan against a map seen from behind it, whose filled points
+    cut corners from there: along the ``ring``'s 150 m of corridor a lap the estimate comes
+    out too large (measured 0.24 %, ATE 9.3 cm), which no loop closure sees. The two
+    symmetric edges of ``pair_edges`` (each keyframe's cloud refined against the previous
+    one's and back) cancel it: measured 0.008 %, ATE 3.06 cm (seed 1: 0.017 %, 3.87 cm)."""
+    log = simulate(load_world("ring"), seed=0, laps=2)
+    plain = run_slam(log)
+    paired = run_slam(log, params=GraphSlamParams(pair_edges=True))
+    assert _scale(plain.poses, log.truth) <= 1 - 0.0015  # measured 1 - 0.0024
+    assert abs(_scale(paired.poses, log.truth) - 1) <= 0.0008  # measured 8e-5
+    assert ate(paired.poses, log.truth).rmse <= 0.05  # measured 3.06 cm (9.26 without)

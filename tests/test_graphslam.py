@@ -130,14 +130,18 @@ def test_the_paper_worlds_single_return_is_closed_by_a_repeated_closure():
     its one return to the first corridor keyframes 126-127 match keyframes 24-25, unique,
     11.6 cm from the estimate, and no independent closure comes to confirm them. With
     ``loop_repeat_confirm`` 0 (before stop 46) they lapsed, and the draw ended at an ATE of
-    6.48 cm on this machine, decided by that threshold; with the default two of them confirm
-    each other and the return is closed."""
+    6.48 cm on the machine of stop 45, decided by that threshold; with the default two of
+    them confirm each other and the return is closed (24->126 and 24->127, 1.51 cm). How far
+    the matches would move keyframe 127 turns on the CPU's last bits: on the machine of stop
+    47 it is under 10 cm, and 24->127 enters at once, with or without ``loop_repeat_confirm``
+    (1.24 cm). So this pins the return, however it is confirmed; the confirmation itself is
+    pinned on canned closures (above)."""
     log = perturb_odometry(simulate(load_world("paper"), seed=0), 6)
     slam = GraphFastHoughSLAM()
     r = run_backend(slam, log)
     returns = [lc for lc in slam.accepted_loops if lc.old <= 30 and lc.new >= 120]
-    assert len(returns) >= 2  # measured 24->126 and 24->127 (none with loop_repeat_confirm 0)
-    assert ate(r.poses, log.truth).rmse <= 0.03  # issue 10's limit; measured 1.51 cm
+    assert len(returns) >= 1  # measured 24->126 and 24->127 (stop 45), 24->127 (stop 47)
+    assert ate(r.poses, log.truth).rmse <= 0.03  # issue 10's limit; measured 1.51 / 1.24 cm
 
 
 def test_a_corridor_ring_comes_back_to_its_start_without_a_false_closure():
@@ -894,10 +898,11 @@ def test_pair_edges_take_the_scale_out_of_the_ring():
     cut corners from there: along the ``ring``'s 150 m of corridor a lap the estimate comes
     out too large (measured 0.24 %, ATE 9.3 cm), which no loop closure sees. The two
     symmetric edges of ``pair_edges`` (each keyframe's cloud refined against the previous
-    one's and back) cancel it: measured 0.008 %, ATE 3.06 cm (seed 1: 0.017 %, 3.87 cm)."""
+    one's and back, translation only) cancel it: measured 0.011 %, ATE 3.03 cm (seed 1:
+    0.013 %, 1.76 cm)."""
     log = simulate(load_world("ring"), seed=0, laps=2)
     plain = run_slam(log)
     paired = run_slam(log, params=GraphSlamParams(pair_edges=True))
     assert _scale(plain.poses, log.truth) <= 1 - 0.0015  # measured 1 - 0.0024
-    assert abs(_scale(paired.poses, log.truth) - 1) <= 0.0008  # measured 8e-5
-    assert ate(paired.poses, log.truth).rmse <= 0.05  # measured 3.06 cm (9.26 without)
+    assert abs(_scale(paired.poses, log.truth) - 1) <= 0.0008  # measured 1.1e-4
+    assert ate(paired.poses, log.truth).rmse <= 0.05  # measured 3.03 cm (9.26 without)

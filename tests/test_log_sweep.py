@@ -134,7 +134,8 @@ def test_graph_parameters_reach_the_runs(hall, capsys):
     from fhslam.slam import GraphSlamParams
 
     """``--set`` (``params``): keyframes every metre instead of every half metre move the
-    run; the table says so."""
+    run; the table says so. (The printed table rounds to 0.1 mm: on the machine of stop 47
+    both runs printed 0.0026 m, so the runs are compared at full precision.)"""
     path, relations = hall
     args = ["sweep", "--log", str(path), "--relations", str(relations), "--seeds", "1",
             "--range-noise", "0.001", "--jobs", "1", "--quiet"]  # fmt: skip
@@ -144,11 +145,12 @@ def test_graph_parameters_reach_the_runs(hall, capsys):
     other = capsys.readouterr().out.splitlines()[0]
     assert default.startswith(f"{path}, graph: as read ")
     assert other.startswith(f"{path}, graph (keyframe_distance=1.0): as read ")
-    assert other.partition(" as read ")[2] != default.partition(" as read ")[2]
     params = GraphSlamParams(keyframe_distance=1.0)
-    kw = dict(seeds=[0], range_noise=0.001, n_jobs=1, progress=False, params=params)
-    rows = log_sweep(path, relations, methods=("graph", "fht"), **kw)
+    kw = dict(seeds=[0], range_noise=0.001, n_jobs=1, progress=False)
+    rows = log_sweep(path, relations, methods=("graph", "fht"), params=params, **kw)
     assert [r.settings for r in rows] == ["keyframe_distance=1.0"] * 2 + [""] * 2
+    plain = log_sweep(path, relations, methods=("graph",), **kw)
+    assert [r.trans_error for r in rows[:2]] != [r.trans_error for r in plain]
 
 
 def test_the_simulated_sweep_takes_graph_parameters_too(monkeypatch, capsys):

@@ -156,11 +156,12 @@ class GraphSlamParams:
         it was seen: with range noise that pushes each keyframe a little ahead along a
         corridor, the same way every time, a scale that no loop closure can see (the
         ``ring``: its trajectory 0.20-0.26 % too large). Matched the other way round, the
-        push is backwards; the two directions of one pair cancel it: the ``ring`` (2 laps,
-        seeds 0-3) 9.3, 10.9, 9.8, 9.6 cm -> 3.0, 1.8, 5.8, 10.1 cm, its scale within
-        0.034 % (seed 3's error is a turn). Added at stop 47, off by default until the
-        defaults' every measurement is made again with it (README, *Not solved: long
-        corridors*).
+        push is backwards, and somewhat larger (the 180° laser looks ahead in both clouds):
+        with the tracker's edge the two balance it, measured, not derived: the ``ring`` (2
+        laps, seeds 0-3) 9.3, 10.9, 9.8, 9.6 cm -> 3.0, 1.8, 5.8, 10.1 cm, its scale within
+        0.034 % (seed 3's error is a turn). Added at stop 47, off by default: the paper
+        world and one of the Freiburg hospital's 30 perturbed runs lose with it (README,
+        *Not solved: long corridors*).
     loop_radius : float
         Old keyframes that looked within this distance of where the keyframe looks are loop
         candidates (where a keyframe looks: the mean of its cloud, placed at the current

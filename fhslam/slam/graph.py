@@ -148,20 +148,21 @@ class GraphSlamParams:
     odometry_sigma : (float, float)
         The odometry prior added to each edge between consecutive keyframes: metres, degrees.
     pair_edges : bool
-        Also join consecutive keyframes by two *symmetric* edges: keyframe ``k``'s cloud
-        refined against ``k - 1``'s, and ``k - 1``'s against ``k``'s (point-to-line from the
-        tracked relative pose, each with its own information about the translation,
-        :meth:`_pair_edges`). The tracker's edge places a scan against a map seen from
-        behind it, and a map's filled points cut an alcove's or a door's corners from where
-        it was seen: with range noise that pushes each keyframe a little ahead along a
-        corridor, the same way every time, a scale that no loop closure can see (the
-        ``ring``: its trajectory 0.20-0.26 % too large). Matched the other way round, the
-        push is backwards, and somewhat larger (the 180° laser looks ahead in both clouds):
-        with the tracker's edge the two balance it, measured, not derived: the ``ring`` (2
-        laps, seeds 0-3) 9.3, 10.9, 9.8, 9.6 cm -> 3.0, 1.8, 5.8, 10.1 cm, its scale within
-        0.034 % (seed 3's error is a turn). Added at stop 47, off by default: the paper
-        world and one of the Freiburg hospital's 30 perturbed runs lose with it (README,
-        *Not solved: long corridors*).
+        Also join consecutive keyframes by two more edges, one each way: keyframe ``k``'s
+        cloud refined against ``k - 1``'s, and ``k - 1``'s against ``k``'s (point-to-line
+        from the tracked relative pose, each with its own information about the
+        translation, :meth:`_pair_edges`; not where either keyframe's scans were doubtful,
+        as the tracker's edge then carries the odometry alone). The tracker's edge places a
+        scan against a map seen from behind it, and a map's filled points cut an alcove's
+        or a door's corners from where it was seen: with range noise that pushes each
+        keyframe a little ahead along a corridor, the same way every time, a scale that no
+        loop closure can see (the ``ring``: its trajectory 0.20-0.26 % too large). Matched
+        the other way round, the push is backwards, and somewhat larger (the 180° laser
+        looks ahead in both clouds): with the tracker's edge the two balance it, measured,
+        not derived: the ``ring`` (2 laps, seeds 0-3) 9.3, 10.9, 9.8, 9.6 cm -> 3.0, 1.8,
+        5.8, 10.1 cm, its scale within 0.034 % (seed 3's error is a turn). Added at stop 47,
+        off by default: the paper world and one of the Freiburg hospital's 30 perturbed runs
+        lose with it (README, *Not solved: long corridors*).
     loop_radius : float
         Old keyframes that looked within this distance of where the keyframe looks are loop
         candidates (where a keyframe looks: the mean of its cloud, placed at the current
@@ -712,6 +713,7 @@ class GraphFastHoughSLAM:
         self._blind = (0.0, 0.0)  # (blind stretch a global closure ended, path it holds to)
         self._kf_doubt = False  # whether a scan since the last keyframe was doubtful
         self._kf_glitch = False  # whether the odometry glitched since the last keyframe
+        self._edge_sure = False  # whether the last keyframe edge carried a sure track
         self._scan_kf: list[int] = []
         self._scan_rel: list[NDArray[np.float64]] = []
         self.loop_targets = LoopTargetCache()
@@ -868,10 +870,11 @@ class GraphFastHoughSLAM:
             # back end only reads it.
             self._complete(n - 1)
             self._in_turn(self._add_keyframe, n, z, info)
-            if p.pair_edges and sure and n >= 2:
-                # keyframes n-2 and n-1 are both complete now
+            if p.pair_edges and sure and self._edge_sure and n >= 2:
+                # keyframes n-2 and n-1 are both complete now, neither's scans doubtful
                 guess = relative(self._kf_front[n - 2], self._kf_front[n - 1])
                 self._in_turn(self._pair_edges, n - 2, n - 1, guess)
+            self._edge_sure = sure
         self._kf_front.append(pose.copy())
         self._kf_odometry.append(odometry.copy())
         self._clouds.append(np.zeros((0, 2)))

@@ -161,8 +161,9 @@ class GraphSlamParams:
         looks ahead in both clouds): with the tracker's edge the two balance it, measured,
         not derived: the ``ring`` (2 laps, seeds 0-3) 9.3, 10.9, 9.8, 9.6 cm -> 3.0, 1.8,
         5.8, 10.1 cm, its scale within 0.034 % (seed 3's error is a turn). Added at stop 47,
-        off by default: the paper world and one of the Freiburg hospital's 30 perturbed runs
-        lose with it (README, *Not solved: long corridors*).
+        off by default: the shared logs and the Freiburg hospital's 32 perturbed runs hold
+        with it, but the paper world loses (3 of the 120 simulated yardstick runs over 3 cm,
+        none without; README, *Not solved: long corridors*).
     loop_radius : float
         Old keyframes that looked within this distance of where the keyframe looks are loop
         candidates (where a keyframe looks: the mean of its cloud, placed at the current

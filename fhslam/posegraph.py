@@ -254,6 +254,17 @@ class PoseGraph:
         """Replace edge ``e``'s measurement."""
         self._z[e] = np.asarray(z, dtype=float).copy()
 
+    def information(self, e: int) -> NDArray[np.float64]:
+        """Edge ``e``'s information (a copy)."""
+        return self._info[e].copy()
+
+    def set_information(self, e: int, information: ArrayLike) -> None:
+        """Replace edge ``e``'s information (3 x 3, symmetric positive semi-definite)."""
+        info = np.asarray(information, dtype=float)
+        if info.shape != (3, 3) or not np.all(np.isfinite(info)):
+            raise ValueError(f"edge information must be a finite 3 x 3 matrix, got {info.shape}")
+        self._info[e] = info.copy()
+
     @property
     def edges(self) -> tuple[NDArray[np.intp], NDArray[np.intp], NDArray[np.float64], list[str]]:
         """``(i, j, z, kind)`` of all edges."""

@@ -71,6 +71,11 @@ def test_pose_graph_class_and_bad_input():
     g.optimize()
     np.testing.assert_allclose(g.poses[1], [2.0, 0.0, 0.0], atol=1e-9)
     assert g.edges[3] == ["odometry"]
+    g.set_information(e, np.diag([1e4, 1e4, 1e2]))
+    np.testing.assert_array_equal(g.information(e), np.diag([1e4, 1e4, 1e2]))
+    for bad in ([1.0, 2.0, 3.0], np.full((3, 3), np.nan)):
+        with pytest.raises(ValueError, match="finite 3 x 3"):
+            g.set_information(e, bad)
     with pytest.raises(ValueError, match="two different nodes"):
         g.add_edge(0, 0, [0, 0, 0], [1, 1, 1])
     with pytest.raises(ValueError, match="two different nodes"):

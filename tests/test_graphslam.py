@@ -900,7 +900,7 @@ def test_pair_edges_take_the_scale_out_of_the_ring():
     of ``pair_edges`` (each keyframe's cloud refined against the previous one's and back,
     translation only), whose pushes go the other way on balance, take it out with the
     tracker's edge: measured 0.011 %, ATE 3.03 cm (seed 1: 0.013 %, 1.76 cm), each edge
-    with the whole of its information (stop 47; ``pair_share`` false)."""
+    with the whole of its information (``pair_share`` false)."""
     log = simulate(load_world("ring"), seed=0, laps=2)
     plain = run_slam(log)
     paired = run_slam(log, params=GraphSlamParams(pair_edges=True, pair_share=False))
@@ -954,6 +954,6 @@ def test_shared_pair_edges_take_the_scale_out_of_the_ring_too():
     against the loop closures: measured scale 1 - 7e-5, ATE 3.60 cm (9.26 without pairs,
     3.03 with them unshared)."""
     log = simulate(load_world("ring"), seed=0, laps=2)
-    shared = run_slam(log, params=GraphSlamParams(pair_edges=True))  # shared by default
+    shared = run_slam(log, params=GraphSlamParams(pair_edges=True, pair_share=True))
     assert abs(_scale(shared.poses, log.truth) - 1) <= 0.0008
     assert ate(shared.poses, log.truth).rmse <= 0.05

@@ -951,9 +951,11 @@ def test_shared_pair_edges_count_the_scans_once():
 def test_shared_pair_edges_take_the_scale_out_of_the_ring_too():
     """Shared (``pair_share``), the three edges keep the balance of stop 47's pair edges
     along the ``ring``'s corridors, and the graph weighs the scans as without pairs
-    against the loop closures: measured scale 1 - 7e-5, ATE 3.60 cm (9.26 without pairs,
-    3.03 with them unshared)."""
+    against the loop closures: measured scale 1 + 7e-5, ATE 3.60 cm (9.26 without pairs,
+    3.03 with them unshared). Shared without pairs is an error."""
     log = simulate(load_world("ring"), seed=0, laps=2)
     shared = run_slam(log, params=GraphSlamParams(pair_edges=True, pair_share=True))
     assert abs(_scale(shared.poses, log.truth) - 1) <= 0.0008
     assert ate(shared.poses, log.truth).rmse <= 0.05
+    with pytest.raises(ValueError, match=r"pair_share .* set pair_edges too"):
+        GraphSlamParams(pair_share=True)

@@ -474,6 +474,8 @@ class GraphSlamParams:
                 "submap_keyframes and loop_min_gap must be >= 1, loop_candidates and "
                 "loop_target_keyframes >= 0"
             )
+        if self.pair_share and not self.pair_edges:
+            raise ValueError("pair_share shares the pair edges' information: set pair_edges too")
         if not self.global_after >= 0:
             raise ValueError(f"global_after must be >= 0, got {self.global_after}")
         if self.global_every < 0 or self.global_keyframes < 1:

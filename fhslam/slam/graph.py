@@ -715,8 +715,9 @@ class GraphFastHoughSLAM:
         self._pose: NDArray[np.float64] | None = None
         self._last_odometry: NDArray[np.float64] | None = None
         self._kf_front: list[NDArray[np.float64]] = []  # keyframe poses, tracking frame
-        # with pair_edges: keyframe n -> its tracker edge, information and the scans' part
-        self._kf_edges: dict[int, tuple] = {}
+        # with pair_edges: keyframe n -> its sure tracker edge and that edge's scan part
+        self._kf_edges: dict[int, tuple[int, NDArray[np.float64]]] = {}
+        self._pair_map: tuple[int, PointMap] | None = None  # the last pair's later cloud
         self._kf_odometry: list[NDArray[np.float64]] = []  # the odometry at each keyframe
         self._clouds: list[NDArray[np.float64]] = []
         self._normals: list[NDArray[np.float64]] = []  # each cloud point's normal or NaN
@@ -928,8 +929,9 @@ class GraphFastHoughSLAM:
         self._graph.add_node(compose(self._graph.pose(n - 1), z))
         e = self._graph.add_edge(n - 1, n, z, info)
         if self.params.pair_edges:
-            self._kf_edges[n] = (e, info, scan_info)
             self._kf_edges.pop(n - 2, None)  # its pair, if any, is made by now
+            if scan_info is not None:
+                self._kf_edges[n] = (e, scan_info)
         if n >= 2:
             self._close_loops(n - 1)
 
@@ -941,13 +943,15 @@ class GraphFastHoughSLAM:
         about the heading: it comes from the same scans as the tracker's edge, which
         already holds it."""
         t = self.params.tracker
+        maps = {a: self._pair_map[1]} if self._pair_map and self._pair_map[0] == a else {}
+        for m in (a, b):
+            if m not in maps:
+                maps[m] = PointMap.build(*self._cloud(m))
+        self._pair_map = (b, maps[b])  # the next pair's earlier keyframe
         made = []
         for target, query, x in ((a, b, guess), (b, a, inverse(guess))):
-            points, normals = self._cloud(target)
             q = voxel_downsample(self._cloud(query)[0], t.query_voxel)
-            ref = refine(
-                PointMap.build(points, normals), q, x, t.refine_distance, t.refine_iterations
-            )
+            ref = refine(maps[target], q, x, t.refine_distance, t.refine_iterations)
             if ref.n_matched >= 10 and np.hypot(*(ref.pose[:2] - x[:2])) <= t.window:
                 h = self._information(ref, float(ref.pose[2]))
                 if not h[2, 2] > 0:
@@ -958,13 +962,14 @@ class GraphFastHoughSLAM:
                 info[:2, :2] = h[:2, :2] - np.outer(h[:2, 2], h[2, :2]) / h[2, 2]
                 made.append((target, query, ref.pose, info))
         share = 1.0
-        edge, edge_info, scan_info = self._kf_edges.pop(b, (-1, None, None))
+        edge, scan_info = self._kf_edges.pop(b, (-1, None))
         if self.params.pair_share and made and scan_info is not None:
             # the tracker's edge and the pairs, from the same scans, share their information
             # about the translation (its odometry prior and heading stay whole)
             share = 1.0 / (1 + len(made))
             s = np.diag([np.sqrt(share), np.sqrt(share), 1.0])
-            self._graph.set_information(edge, edge_info - scan_info + s @ scan_info @ s)
+            info = self._graph.information(edge) - scan_info + s @ scan_info @ s
+            self._graph.set_information(edge, info)
         for target, query, z, info in made:
             self._graph.add_edge(target, query, z, share * info, kind="pair")
 

@@ -879,6 +879,7 @@ def densify(
     step: float = 0.02,
     max_gap: float = 0.1,
     max_gap_per_metre: float = 0.03,
+    corner_deg: float | None = None,
 ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """A scan (laser frame, beam order) with points filled in every ``step`` metres between
     consecutive beams that lie on one surface (closer than ``max_gap + max_gap_per_metre ×
@@ -888,29 +889,62 @@ def densify(
     line that a likelihood grid scores low wherever a query point falls between the dots;
     filled in, it scores as the wall it is.
 
+    With ``corner_deg``, the points filled in across a chord that turns by more than
+    ``corner_deg`` from both neighbouring chords (or has none) get no normal (NaN): such a
+    chord joins two surfaces, cutting a corner, and its points lie off both (behind a
+    convex corner, in front of a concave one), by centimetres where the beams are far
+    apart. They are still points (a likelihood grid scores them); a point-to-line match
+    (:class:`PointMap`) leaves them out.
+
     Compiled (:func:`_densify`), with NumPy's operations in its order: the same points and
     normals, bit for bit.
     """
     p = as_points(points, "points")
     nrm = np.asarray(normals, dtype=float).reshape(-1, 2)
+    if len(nrm) != len(p):
+        raise ValueError(f"{len(nrm)} normals for {len(p)} points")
+    if corner_deg is not None and not 0 < corner_deg <= 90:
+        raise ValueError(f"corner_deg must be in (0, 90] degrees, got {corner_deg}")
     if len(p) < 2:
         return p, nrm
-    dense, dense_normals = _densify(p, nrm, float(step), float(max_gap), float(max_gap_per_metre))
+    dense, dense_normals, k, linked = _densify(
+        p, nrm, float(step), float(max_gap), float(max_gap_per_metre)
+    )
     if len(dense) == len(p):
         return p, nrm
+    if corner_deg is not None:
+        corner = _corner_chords(p, linked, corner_deg) & (k > 0)
+        dense_normals[len(p) :][np.repeat(corner, k)] = np.nan
     return dense, dense_normals
+
+
+def _corner_chords(p, linked, corner_deg):
+    """Which chords between consecutive points ``p`` turn by more than ``corner_deg`` from
+    each neighbour on the same surface (``linked``: closer than :func:`densify`'s gap), or
+    have no such neighbour."""
+    d = np.diff(p, axis=0)
+    u = d / np.maximum(np.hypot(*d.T), 1e-300)[:, None]
+    straight = linked[1:] & linked[:-1]
+    straight &= np.abs((u[1:] * u[:-1]).sum(1)) >= np.cos(np.radians(corner_deg))
+    along = np.zeros(len(d), bool)
+    along[:-1] |= straight
+    along[1:] |= straight
+    return ~along
 
 
 @njit(cache=True, nogil=True)
 def _densify(p, nrm, step, max_gap, max_gap_per_metre):  # pragma: no cover
     """:func:`densify`: the filled points follow the scan's, pair by pair, each at
-    ``(j + 1) / (k + 1)`` of its pair's gap."""
+    ``(j + 1) / (k + 1)`` of its pair's gap; also ``k``, the points filled in each gap, and
+    which gaps passed the test (``linked``; ``k`` is 0 in those shorter than ``step``)."""
     n = p.shape[0]
     k = np.zeros(n - 1, np.int64)
+    linked = np.zeros(n - 1, np.bool_)
     for i in range(n - 1):
         gap = np.hypot(p[i + 1, 0] - p[i, 0], p[i + 1, 1] - p[i, 1])
         if gap <= max_gap + max_gap_per_metre * np.hypot(p[i, 0], p[i, 1]):
             k[i] = int(np.floor(gap / step))
+            linked[i] = True
     total = n + k.sum()
     out_p, out_n = np.empty((total, 2)), np.empty((total, 2))
     out_p[:n], out_n[:n] = p, nrm
@@ -923,10 +957,12 @@ def _densify(p, nrm, step, max_gap, max_gap_per_metre):  # pragma: no cover
             out_p[r, 0], out_p[r, 1] = p[i, 0] + t * dx, p[i, 1] + t * dy
             out_n[r, 0], out_n[r, 1] = -(dy / gap), dx / gap
             r += 1
-    return out_p, out_n
+    return out_p, out_n, k, linked
 
 
-def _densify_numpy(points, normals, step=0.02, max_gap=0.1, max_gap_per_metre=0.03):
+def _densify_numpy(
+    points, normals, step=0.02, max_gap=0.1, max_gap_per_metre=0.03, corner_deg=None
+):
     """:func:`densify` in NumPy (the kernel's reference in the tests)."""
     p = as_points(points, "points")
     nrm = np.asarray(normals, dtype=float).reshape(-1, 2)
@@ -935,14 +971,18 @@ def _densify_numpy(points, normals, step=0.02, max_gap=0.1, max_gap_per_metre=0.
     d = np.diff(p, axis=0)
     gap = np.hypot(*d.T)
     limit = max_gap + max_gap_per_metre * np.hypot(*p[:-1].T)
-    k = np.where(gap <= limit, np.floor(gap / step).astype(np.intp), 0)
+    linked = gap <= limit
+    k = np.where(linked, np.floor(gap / step).astype(np.intp), 0)
     pair = np.repeat(np.arange(len(d)), k)
     if len(pair) == 0:
         return p, nrm
     t = (np.arange(len(pair)) - np.repeat(np.cumsum(k) - k, k) + 1) / np.repeat(k + 1, k)
     fill = p[pair] + t[:, None] * d[pair]
     u = d[pair] / gap[pair, None]
-    return np.vstack([p, fill]), np.vstack([nrm, np.column_stack([-u[:, 1], u[:, 0]])])
+    fill_normals = np.column_stack([-u[:, 1], u[:, 0]])
+    if corner_deg is not None:
+        fill_normals[_corner_chords(p, linked, corner_deg)[pair]] = np.nan
+    return np.vstack([p, fill]), np.vstack([nrm, fill_normals])
 
 
 # -- point-to-line refinement ---------------------------------------------------------------

@@ -35,5 +35,7 @@ def test_refinement_bias_bad_input():
         refinement_bias("ring", n_scans=20, first=30)
     with pytest.raises(ValueError, match="map_scans <= first"):
         refinement_bias("ring", first=3, map_scans=6)
+    with pytest.raises(ValueError, match="and a seed"):
+        refinement_bias("ring", seeds=())
     with pytest.raises(ValueError, match="corner_deg must be in"):
         refinement_bias("ring", seeds=(0,), n_scans=40, corner_deg=-1.0)

@@ -73,10 +73,10 @@ def refinement_bias(
     :class:`~fhslam.slam.GraphSlamParams` (0: off). The refinement is the tracker's
     (:class:`~fhslam.slam.tracker.TrackerParams`' ``refine_distance`` and
     ``refine_iterations``) without its odometry prior."""
-    if not (1 <= map_scans <= first < n_scans and every >= 1):
+    if not (1 <= map_scans <= first < n_scans and every >= 1 and len(seeds)):
         raise ValueError(
-            f"need 1 <= map_scans <= first < n_scans and every >= 1, got map_scans="
-            f"{map_scans}, first={first}, n_scans={n_scans}, every={every}"
+            f"need 1 <= map_scans <= first < n_scans, every >= 1 and a seed, got map_scans="
+            f"{map_scans}, first={first}, n_scans={n_scans}, every={every}, seeds={seeds}"
         )
     tracker, params = TrackerParams(), GraphSlamParams(corner_deg=corner_deg)
     rows = []
@@ -87,6 +87,8 @@ def refinement_bias(
             odometry=OdometryNoise(0, 0, 0, 0, 0, 0, 0),
             max_scans=n_scans,
         )
+        if len(log) <= first:
+            raise ValueError(f"the {world!r} run has {len(log)} scans: none to refine from {first}")
         scans = [log.scan(i).points()[0] for i in range(len(log))]
         truth = log.truth
         for k in range(first, len(log), every):
@@ -106,7 +108,5 @@ def refinement_bias(
             th = truth[k, 2]
             along = e[0] * np.cos(th) + e[1] * np.sin(th)
             rows.append((seed, k, along, np.angle(np.exp(1j * e[2]))))
-    if not rows:
-        raise ValueError(f"no scan to refine: the {world!r} run has fewer than {first + 1}")
     seed_, scan_, along_, heading_ = (np.array(c) for c in zip(*rows, strict=True))
     return RefinementBias(seed_.astype(np.int64), scan_.astype(np.int64), along_, heading_)

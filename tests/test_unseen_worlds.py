@@ -7,7 +7,7 @@ odometry (2–6 m off), its frame moved by (−3.3, 2.1) m and turned 37°, with
 every range and 10 % of the scans dropped — the hardest of the conditions issue 10 names,
 all at once. Measured at stop 50 (README, *SLAM on simulated worlds*): ATE 0.33, 0.37, 0.52
 and 0.43 cm; the same four conditions over ``random:300`` … ``random:339`` stay within
-0.31–0.92 cm. The bound is issue 10's limit, not the measurement: the test says the
+0.30–0.92 cm (README). The bound is issue 10's limit, not the measurement: the test says the
 defaults generalise, not that these four numbers hold to the last bit.
 """
 

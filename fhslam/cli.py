@@ -46,8 +46,9 @@ PROFILE_HELP = (
 
 def _simulate(args: argparse.Namespace) -> None:
     from fhslam.errors import InputError
-    from fhslam.io import write_carmen, write_trajectory
+    from fhslam.io import write_carmen, write_relations, write_trajectory
     from fhslam.io.files import check_outputs, output_batch
+    from fhslam.metrics import sample_relations
     from fhslam.sim import OdometryNoise, load_world, simulate
     from fhslam.sim.simulate import check_scan_limit, is_closed_route
     from fhslam.sim.world import BUILTIN_WORLDS
@@ -58,7 +59,7 @@ def _simulate(args: argparse.Namespace) -> None:
         raise InputError(f"--laps must be between 1 and {MAX_LAPS}, got {args.laps}")
     builtin = args.world in BUILTIN_WORLDS or args.world.startswith("random:")
     check_outputs(
-        {"--log": args.log, "--truth": args.truth},
+        {"--log": args.log, "--truth": args.truth, "--relations": args.relations},
         {"the input world file": None if builtin else args.world},
     )
     world = load_world(args.world)
@@ -80,7 +81,17 @@ def _simulate(args: argparse.Namespace) -> None:
             log.truth,
             header=f"ground truth of {world.name!r}, seed {args.seed}: timestamp x y theta",
         )
-    print(f"wrote {len(log)} scans to {args.log} and the true poses to {args.truth}")
+        if args.relations is not None:
+            rel = sample_relations(log.timestamps, log.truth)
+            write_relations(
+                args.relations,
+                *rel,
+                header=f"relations sampled from the truth of {world.name!r}, seed "
+                f"{args.seed} (fhslam.metrics.sample_relations): timestamp1 timestamp2 x y z "
+                "roll pitch yaw",
+            )
+    also = "" if args.relations is None else f", {len(rel[0])} relations to {args.relations}"
+    print(f"wrote {len(log)} scans to {args.log} and the true poses to {args.truth}{also}")
 
 
 def _load(args: argparse.Namespace):
@@ -649,6 +660,12 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
     p.add_argument("--log", required=True, type=Path, help="output CARMEN log (.clf)")
     p.add_argument("--truth", required=True, type=Path, help="output truth file")
+    p.add_argument(
+        "--relations",
+        type=Path,
+        help="also write benchmark relations sampled from the truth "
+        "(fhslam.metrics.sample_relations), for `fhslam evaluate --relations`",
+    )
     p.add_argument(
         "--odometry",
         choices=("default", "drifting"),

@@ -12,8 +12,14 @@ from conftest import data_dir
 
 from fhslam.cli import main
 from fhslam.geometry import compose, relative
-from fhslam.io import RelationsFormatError, read_carmen, read_relations, write_trajectory
-from fhslam.metrics import RelationsError, relations_error, relations_errors
+from fhslam.io import (
+    RelationsFormatError,
+    read_carmen,
+    read_relations,
+    write_trajectory,
+)
+from fhslam.io import write_relations as save_relations
+from fhslam.metrics import RelationsError, relations_error, relations_errors, sample_relations
 
 FIELDS = (
     "trans_mean",
@@ -375,3 +381,99 @@ def test_mit_csail_odometry_against_its_relations():
     assert np.isfinite(e.rot_mean_deg) and e.rot_mean_deg > 0
     # The rounding is below 10 µs: with 0.1 ms of slack every relation still matches.
     assert relations_error(log.timestamps, log.odometry, t1, t2, rel, max_diff=1e-4).n_used == 1172
+
+
+def lap(n_per_lap: int = 399, laps: int = 2) -> tuple[np.ndarray, np.ndarray]:
+    """A circle of radius 5 m driven ``laps`` times at 8/3 Hz, 150 s a lap."""
+    a = 2 * np.pi * np.arange(n_per_lap * laps) / n_per_lap
+    poses = np.column_stack([5 * np.cos(a), 5 * np.sin(a), a + np.pi / 2])
+    return 1000.0 + 0.375 * np.arange(len(a)), poses
+
+
+def test_sampled_relations_step_along_the_path_and_join_revisits():
+    t, p = lap()
+    t1, t2, rel = sample_relations(t, p)
+    chord = 10 * np.sin(np.pi / 399)  # 7.87 cm a pose: anchors every 7th (0.55 m, 6.3 deg)
+    seq = np.arange(len(t1)) < (len(t) - 1) // 7  # one relation from each anchor to the next
+    np.testing.assert_allclose(np.diff(t1[seq]), 7 * 0.375)
+    np.testing.assert_allclose(np.hypot(rel[seq, 0], rel[seq, 1]), 10 * np.sin(7 * np.pi / 399))
+    np.testing.assert_allclose(rel[seq, 2], 14 * np.pi / 399)
+    assert chord < 0.08
+    # revisits: the 57 anchors of the second lap lie on those of the first, 150 s later
+    # (identity relations), and the first lap's last anchor, 0.55 m short of the start
+    # and 147 s after it, joins the first
+    rev = ~seq
+    assert rev.sum() == 58
+    same = np.isclose(t2 - t1, 399 * 0.375)
+    assert same.sum() == 57 and not same[seq].any()
+    np.testing.assert_allclose(rel[same], 0.0, atol=1e-9)
+    # on the truth the error is zero; on a copy whose second lap is shifted by 0.3 m
+    # only its revisits and the one relation across the shift see it
+    e = relations_error(t, p, t1, t2, rel)
+    assert e.trans_mean == pytest.approx(0.0, abs=1e-12) and e.n_used == len(t1)
+    moved = p.copy()
+    moved[399:, 0] += 0.3
+    trans, _, _ = relations_errors(t, moved, t1, t2, rel)
+    np.testing.assert_allclose(trans[same], 0.3, rtol=1e-9)
+    assert np.count_nonzero(trans[~same] > 1e-9) == 1
+
+
+def test_sampled_relations_are_frame_invariant_and_turns_make_anchors():
+    t, p = lap(laps=1)
+    moved = np.column_stack(
+        [
+            p[:, 0] * np.cos(0.6) - p[:, 1] * np.sin(0.6) - 3.3,
+            p[:, 0] * np.sin(0.6) + p[:, 1] * np.cos(0.6) + 2.1,
+            p[:, 2] + 0.6,
+        ]
+    )
+    a, b = sample_relations(t, p), sample_relations(t, moved)
+    np.testing.assert_array_equal(a[0], b[0])
+    np.testing.assert_allclose(a[2], b[2], atol=1e-9)
+    # turning on the spot by 0.7 degrees a pose: an anchor every 15 poses (10.5 degrees)
+    spin = np.column_stack([np.zeros(106), np.zeros(106), np.radians(0.7 * np.arange(106))])
+    t1, _, rel = sample_relations(0.1 * np.arange(106), spin)
+    assert len(t1) == 7
+    np.testing.assert_allclose(np.degrees(rel[:, 2]), 10.5, atol=1e-9)
+
+
+@pytest.mark.parametrize(
+    "args, message",
+    [
+        ((np.arange(3.0), np.zeros((2, 3))), "one pose per timestamp"),
+        ((np.arange(3.0), np.full((3, 3), np.nan)), "truth must be finite"),
+        ((np.array([0.0, 1.0, 1.0]), np.zeros((3, 3))), "strictly increasing"),
+        ((np.arange(3.0), np.zeros((3, 3))), "too little for one relation"),
+        ((np.arange(3.0), np.zeros((3, 3)), 0.0), "step must be a positive number"),
+    ],
+)
+def test_sample_relations_bad_input(args, message):
+    with pytest.raises(ValueError, match=message):
+        sample_relations(*args)
+
+
+def test_write_relations_round_trip_and_bad_input(tmp_path):
+    t, p = lap(laps=1)
+    t1, t2, rel = sample_relations(t, p)
+    path = tmp_path / "r.relations"
+    save_relations(path, t1, t2, rel, header="made here\nsecond line")
+    assert path.read_text().startswith("# made here\n# second line\n")
+    r1, r2, rr = read_relations(path)
+    np.testing.assert_array_equal(r1, t1)
+    np.testing.assert_array_equal(r2, t2)
+    np.testing.assert_array_equal(rr, rel)
+    with pytest.raises(ValueError, match="shapes"):
+        save_relations(path, t1, t2[:-1], rel)
+    with pytest.raises(ValueError, match="finite"):
+        save_relations(path, t1, t2, np.full_like(rel, np.inf))
+
+
+def test_simulate_relations_measure_a_run_as_a_real_log_is(tmp_path, capsys):
+    log, truth, rel = tmp_path / "c.clf", tmp_path / "t.txt", tmp_path / "c.relations"
+    main(["simulate", "corridor", "--log", str(log), "--truth", str(truth),
+          "--relations", str(rel)])  # fmt: skip
+    assert "61 relations to" in capsys.readouterr().out
+    main(["evaluate", str(truth), "--relations", str(rel), "--json"])
+    e = json.loads(capsys.readouterr().out)
+    assert e["relations_used"] == e["relations_total"] == 61
+    assert e["relations_trans_mean"] == pytest.approx(0.0, abs=1e-9)

@@ -15,7 +15,7 @@ from fhslam.io.carmen import (
 from fhslam.io.graphfile import GraphFormatError, KeyframeGraph, read_graph, write_graph
 from fhslam.io.log import Log, effective_max_range, no_return_reading
 from fhslam.io.mapfile import MapFormatError, lines_from_segments, read_map, write_map
-from fhslam.io.relations import RelationsFormatError, read_relations
+from fhslam.io.relations import RelationsFormatError, read_relations, write_relations
 from fhslam.io.rosbag import BagFormatError, BagWarning, is_bag, read_bag
 from fhslam.io.trajectory import (
     TrajectoryFormatError,
@@ -50,5 +50,6 @@ __all__ = [
     "write_carmen",
     "write_graph",
     "write_map",
+    "write_relations",
     "write_trajectory",
 ]

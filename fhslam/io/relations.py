@@ -15,9 +15,10 @@ from __future__ import annotations
 from os import PathLike
 
 import numpy as np
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 
 from fhslam.errors import InputError
+from fhslam.io.files import atomic_output
 from fhslam.io.log import read_numeric_table
 
 PLANAR_TOL = 1e-6
@@ -68,3 +69,47 @@ def read_relations(
 
     a = read_numeric_table(path, _FIELDS, RelationsFormatError, "relations", planar)
     return a[:, 0], a[:, 1], a[:, [2, 3, 7]]
+
+
+def write_relations(
+    path: str | PathLike[str],
+    t1: ArrayLike,
+    t2: ArrayLike,
+    rel: ArrayLike,
+    header: str | None = None,
+) -> None:
+    """Write planar relations as ``timestamp1 timestamp2 x y z roll pitch yaw`` lines, the
+    format :func:`read_relations` reads (``z``, ``roll`` and ``pitch`` written as 0).
+
+    Parameters
+    ----------
+    path : str or path-like
+        Output file, overwritten.
+    t1, t2 : array-like, shape (R,)
+        Timestamps of each relation's first and second pose, seconds.
+    rel : array-like, shape (R, 3)
+        ``(x, y, yaw)`` of each relation (metres, radians).
+    header : str, optional
+        Comment lines written first, each prefixed with ``"# "``.
+
+    Raises
+    ------
+    ValueError
+        For inputs of wrong shape, none, or non-finite values.
+    """
+    a, b = np.asarray(t1, dtype=float), np.asarray(t2, dtype=float)
+    r = np.asarray(rel, dtype=float)
+    if a.ndim != 1 or len(a) == 0 or b.shape != a.shape or r.shape != (len(a), 3):
+        raise ValueError(
+            f"t1, t2 and rel must have shapes (R,), (R,), (R, 3) with R >= 1, got "
+            f"{a.shape}, {b.shape}, {r.shape}"
+        )
+    if not (np.all(np.isfinite(a)) and np.all(np.isfinite(b)) and np.all(np.isfinite(r))):
+        raise ValueError("relations must be finite")
+    zeros = np.zeros(len(a))
+    rows = np.column_stack([a, b, r[:, 0], r[:, 1], zeros, zeros, zeros, r[:, 2]]).tolist()
+    with atomic_output(path) as f:
+        for c in (header or "").splitlines():
+            f.write(f"# {c}\n")
+        for row in rows:
+            f.write(" ".join(repr(v) for v in row) + "\n")

@@ -22,7 +22,12 @@ from fhslam.metrics.detection import (
     match_scan,
 )
 from fhslam.metrics.map import as_segments, map_coverage, map_error, sample_segments
-from fhslam.metrics.relations import RelationsError, relations_error, relations_errors
+from fhslam.metrics.relations import (
+    RelationsError,
+    relations_error,
+    relations_errors,
+    sample_relations,
+)
 from fhslam.metrics.trajectory import (
     ErrorStats,
     align_se2,
@@ -58,5 +63,6 @@ __all__ = [
     "rpe_errors",
     "rpe_pairs",
     "rpe_rot_deg",
+    "sample_relations",
     "sample_segments",
 ]

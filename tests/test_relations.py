@@ -437,6 +437,17 @@ def test_sampled_relations_are_frame_invariant_and_turns_make_anchors():
     np.testing.assert_allclose(np.degrees(rel[:, 2]), 10.5, atol=1e-9)
 
 
+@pytest.mark.parametrize("seed", range(4))
+def test_sampled_anchors_do_not_hang_on_the_last_bit(seed):
+    # A robot 10 cm a scan reaches 0.5 m at the fifth scan exactly, as a simulated one does;
+    # noise of 1e-12 m (far above a last bit, far below anything measured) moves no anchor.
+    x = 0.1 * np.arange(101) + np.random.default_rng(seed).normal(0.0, 1e-12, 101)
+    t1, t2, rel = sample_relations(np.arange(101.0), np.column_stack([x, 0 * x, 0 * x]))
+    np.testing.assert_array_equal(t1, 5.0 * np.arange(20))
+    np.testing.assert_array_equal(t2, t1 + 5.0)
+    np.testing.assert_allclose(rel[:, 0], 0.5, atol=1e-11)
+
+
 @pytest.mark.parametrize(
     "args, message",
     [

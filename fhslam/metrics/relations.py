@@ -243,10 +243,13 @@ def sample_relations(
         raise ValueError("timestamps must be strictly increasing")
     travel = np.concatenate([[0.0], np.cumsum(np.hypot(*np.diff(p[:, :2], axis=0).T))])
     heading = np.concatenate([[0.0], np.cumsum(np.abs(wrap_angle(np.diff(p[:, 2]))))])
+    # A simulated robot moves in equal steps, so travel often lands on a multiple of `step`
+    # itself; a threshold a hair below it keeps the last bit from choosing the anchors.
+    reach, turn = step * (1.0 - 1e-9), np.radians(10.0) * (1.0 - 1e-9)
     anchors = [0]
     for k in range(1, len(ts)):  # one pass; the thresholds need the anchor before
         a = anchors[-1]
-        if travel[k] - travel[a] >= step or heading[k] - heading[a] >= np.radians(10.0):
+        if travel[k] - travel[a] >= reach or heading[k] - heading[a] >= turn:
             anchors.append(k)
     idx = np.asarray(anchors)
     if len(idx) < 2:

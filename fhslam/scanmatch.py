@@ -43,17 +43,6 @@ __all__ = [
 ]
 
 
-# Voxel cells are offset from the frame's origin by an irrational share of a cell. A laser
-# frame (a keyframe's) puts points exactly on lines through its origin - the beams at 0 and
-# +-90 degrees, and at +-60 degrees x = r / 2 - and ranges come in whole millimetres or
-# centimetres, so cells bounded at multiples of their size (or half of it) cut through
-# such points, and which cell one falls in is decided by the last bit of the pose that
-# placed it (the paper world: one point in a keyframe changed by a 1e-15 perturbation of
-# the odometry, and the run's ATE with it from 1.7 to 5.1 cm). An irrational share keeps
-# every millimetre-rounded value at least 0.05 mm from a cell's edge for the cells used.
-_GRID_OFFSET = 0.5 * (3.0 - 5.0**0.5)  # 0.382: 1 minus the golden ratio's fraction
-
-
 def voxel_downsample(points: ArrayLike, size: float) -> NDArray[np.float64]:
     """Keep the first point of each ``size`` × ``size`` cell (order preserved)."""
     p = np.asarray(points, dtype=float).reshape(-1, 2)
@@ -78,7 +67,7 @@ def _voxel_index_numpy(points: ArrayLike, size: float) -> NDArray[np.intp]:
     """:func:`voxel_index` by ``np.unique`` (the kernel's reference in the tests, and the
     way for points whose cells an int64 does not hold)."""
     p = np.asarray(points, dtype=float).reshape(-1, 2)
-    k = np.floor(p / size + _GRID_OFFSET).astype(np.int64)
+    k = np.floor(p / size).astype(np.int64)
     k -= k.min(axis=0)
     _, first = np.unique(k[:, 0] * (int(k[:, 1].max()) + 1) + k[:, 1], return_index=True)
     return np.sort(first)
@@ -93,7 +82,7 @@ def _first_per_cell(p, size):  # pragma: no cover
     kx = np.empty(n, np.int64)
     ky = np.empty(n, np.int64)
     for i in range(n):
-        fx, fy = np.floor(p[i, 0] / size + _GRID_OFFSET), np.floor(p[i, 1] / size + _GRID_OFFSET)
+        fx, fy = np.floor(p[i, 0] / size), np.floor(p[i, 1] / size)
         if not (abs(fx) < 2.0**52 and abs(fy) < 2.0**52):
             return None
         kx[i], ky[i] = np.int64(fx), np.int64(fy)

@@ -18,7 +18,6 @@ import pytest
 from fhslam.geometry import transform_points
 from fhslam.posegraph import PoseGraph, _chi2, edge_errors
 from fhslam.scanmatch import (
-    _GRID_OFFSET,
     GRID_PAD,
     LikelihoodGrid,
     PointMap,
@@ -103,7 +102,7 @@ def _clouds(rng):
 def _cells_box(p, size):
     """``nx · ny`` of the cells' bounding box, and the bound of :func:`_first_per_cell`'s
     one-pass branch."""
-    k = np.floor(p / size + _GRID_OFFSET).astype(np.int64)
+    k = np.floor(p / size).astype(np.int64)
     nx, ny = k.max(axis=0) - k.min(axis=0) + 1
     return float(nx) * float(ny), 256.0 * len(p) + 65536.0
 

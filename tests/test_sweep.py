@@ -10,7 +10,9 @@ from fhslam.cli import main
 from fhslam.errors import InputError
 from fhslam.experiments.compare import (
     FIELDS,
+    RunResult,
     format_summary,
+    last_bit_spread,
     load_sweep,
     one_run,
     save_sweep,
@@ -219,7 +221,10 @@ def test_a_sweep_runs_every_log_with_each_odometry_draw(tmp_path):
     for s in (0, 1):
         odo = [r.odometry_ate_rmse for r in rows if r.seed == s]
         assert max(odo) - min(odo) <= 1e-9 and len(set(odo)) > 1
-    head = format_summary(rows).splitlines()[0]
+    table = format_summary(rows).splitlines()
+    assert table[-1].startswith("last bit, low odometry: one log's ATE moves by up to 0.00 cm")
+    assert table[-1].endswith("; 0 of 2 logs by more than 1 mm")  # the odometry's: 1e-9 m
+    head = table[0]
     assert head == (
         "6 runs: 2 seeds x 1 levels x 1 methods x 3 odometry draws (last bit); "
         "logs with 5 % of the scans dropped (seed 0)"
@@ -242,6 +247,37 @@ def test_the_graph_method_on_a_degraded_sweep_stays_near_its_clean_result():
     )  # fmt: skip
     assert len(rows) == 2
     assert all(r.ate_rmse <= 0.015 for r in rows), [r.ate_rmse for r in rows]
+    (b,) = last_bit_spread(rows).values()  # whatever it is on this machine, it is reported
+    assert (b.largest, b.seed, b.logs) == (abs(rows[0].ate_rmse - rows[1].ate_rmse), 0, 1)
+
+
+def _run(seed, last_bit, ate, level="low", method="graph", drop=0.0):
+    return RunResult(method, level, seed, ate, 0.5, 0.01, 1.0, 10, drop_fraction=drop,
+                     last_bit=last_bit)  # fmt: skip
+
+
+def test_the_last_bit_spread_is_the_largest_move_of_one_logs_runs():
+    """Runs of one log (level, method, seed, degradation) that differ only in the last bit
+    are compared with each other, never across seeds or degradations: seed 1 moves by
+    3 cm, seed 0 by 0.5 mm (not counted as moved), and the dropped-scans runs of seed 0 by
+    2 mm; a level whose logs ran once each is left out."""
+    rows = [
+        _run(0, 0, 0.0100), _run(0, 1, 0.0105), _run(0, 2, 0.0102),
+        _run(1, 0, 0.0200), _run(1, 1, 0.0500),
+        _run(0, 0, 0.0300, drop=0.1), _run(0, 1, 0.0320, drop=0.1),
+        _run(0, 0, 0.9, level="medium"), _run(1, 0, 0.1, level="medium"),
+    ]  # fmt: skip
+    spread = last_bit_spread(rows)
+    assert list(spread) == [("low", "graph")]
+    b = spread[("low", "graph")]
+    assert b.largest == pytest.approx(0.03, abs=1e-12) and b.seed == 1
+    assert (b.moved, b.logs) == (2, 3)
+    assert format_summary(rows).splitlines()[-1] == (
+        "last bit, low FH-SLAM graph: one log's ATE moves by up to 3.00 cm (seed 1); "
+        "2 of 3 logs by more than 1 mm"
+    )
+    assert last_bit_spread([r for r in rows if r.last_bit == 0]) == {}
+    assert "last bit," not in format_summary([r for r in rows if r.last_bit == 0])
 
 
 @pytest.mark.parametrize(

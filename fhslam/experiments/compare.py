@@ -297,6 +297,46 @@ def summary(rows: Sequence[RunResult]) -> dict[tuple[str, str], dict[str, float]
     return out
 
 
+LAST_BIT_MOVE = 0.001
+"""How far (metres of ATE) a log's runs may differ over last-bit draws before
+:func:`last_bit_spread` counts the log as moved."""
+
+
+@dataclass(frozen=True)
+class LastBitSpread:
+    """How much the last bit of the odometry moves one (level, method)'s ATE in a sweep
+    (issue 10: a result that changes under floating-point noise is not robust)."""
+
+    largest: float
+    """The largest difference (m) between two runs of one log that differ only in the
+    odometry's last bit."""
+    seed: int
+    """The seed of the log with the largest difference."""
+    moved: int
+    """How many logs' runs differ by more than :data:`LAST_BIT_MOVE`."""
+    logs: int
+    """How many logs were drawn more than once."""
+
+
+def last_bit_spread(rows: Sequence[RunResult]) -> dict[tuple[str, str], LastBitSpread]:
+    """Per (level, method), how far the ATE of one log moves over its last-bit draws
+    (``last_bit_draws``): the runs of one log share the level, method, seed and
+    degradation and differ only in ``last_bit``. Levels and methods whose logs were run
+    once each are left out."""
+    groups: dict[tuple, list[float]] = {}
+    for r in rows:
+        log = (r.level, r.method, r.seed, r.range_noise, r.drop_fraction,
+               r.clutter_fraction, r.degrade_seed, r.settings)  # fmt: skip
+        groups.setdefault(log, []).append(r.ate_rmse)
+    out: dict[tuple[str, str], LastBitSpread] = {}
+    for key in sorted({k[:2] for k, v in groups.items() if len(v) > 1}):
+        spread = [(max(v) - min(v), k[2]) for k, v in groups.items() if k[:2] == key and len(v) > 1]
+        largest, seed = max(spread, key=lambda x: (x[0], -x[1]))
+        moved = sum(d > LAST_BIT_MOVE for d, _ in spread)
+        out[key] = LastBitSpread(float(largest), int(seed), moved, len(spread))
+    return out
+
+
 LABELS = {
     "fht": "FH-SLAM (paper)",
     "graph": "FH-SLAM graph",
@@ -346,6 +386,14 @@ def format_summary(rows: Sequence[RunResult]) -> str:
                 f"{lv:7} {LABELS[m]:26} {v['ate_median']:9.3f} m {v['ate_max']:7.3f} m "
                 f"{me_s:>12} {v['ms_per_step_median']:8.2f}"
             )
+    spread = last_bit_spread(rows)
+    for lv, m in [(lv, m) for lv in levels for m in methods if (lv, m) in spread]:
+        b = spread[(lv, m)]
+        lines.append(
+            f"last bit, {lv} {LABELS[m]}: one log's ATE moves by up to {100 * b.largest:.2f} cm "
+            f"(seed {b.seed}); {b.moved} of {b.logs} logs by more than "
+            f"{1000 * LAST_BIT_MOVE:g} mm"
+        )
     return "\n".join(lines)
 
 

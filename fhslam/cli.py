@@ -3,8 +3,13 @@
 Bad input — a missing or malformed file, an unknown world — ends with one line on stderr,
 ``fhslam: error: <file>:<line>: <what>``, and exit status 2; never a traceback. Every command
 checks that it can write each of its outputs before it reads or computes anything, and writes
-them all or none (:mod:`fhslam.io.files`). Ctrl-C ends a command with one line,
-``fhslam: interrupted; ...`` naming what was not written, and exit status 130.
+them all or none (:mod:`fhslam.io.files`); an output that is a device or a pipe (``/dev/null``,
+a FIFO, ``/dev/fd/N``) is written in place, and ``-`` is standard output for the text outputs
+of ``simulate`` and ``slam`` (one of them; the command's messages go to stderr then). Ctrl-C
+ends a command with one line, ``fhslam: interrupted; ...`` naming what was not written, and
+exit status 130. Any other failure is a bug inside the package: one line, ``fhslam: internal
+error: <type>: <message> (please report it; ...)``, and exit status 1; ``fhslam --debug ...``
+(or ``--debug`` after the command) shows its traceback instead.
 """
 
 from __future__ import annotations
@@ -17,8 +22,13 @@ from contextlib import contextmanager
 from pathlib import Path
 
 EXIT_BAD_INPUT = 2
+EXIT_INTERNAL_ERROR = 1
+"""Exit status after a bug inside the package (an exception other than bad input)."""
 EXIT_INTERRUPTED = 130
 """Exit status after Ctrl-C (SIGINT): 128 + 2, as a shell reports it."""
+EXIT_BROKEN_PIPE = 141
+"""Exit status when the reader of standard output went away (``| head``), without a message:
+128 + 13 (SIGPIPE), as a shell reports a command that the signal ended."""
 
 SLAM_METHODS = ("fht", "graph", "classical", "ekf", "odometry")
 """The ``--method`` choices of ``slam`` and ``bench`` (:data:`fhslam.pipeline.METHODS`)."""
@@ -38,6 +48,8 @@ SIMULATE_PROGRESS_SCANS = 5000
 PROFILE_TOP = 25
 """Functions listed by ``--profile``."""
 
+DEBUG_HELP = "show the traceback of an internal error (a bug) instead of its one line"
+
 PROFILE_HELP = (
     f"run under cProfile and print the top {PROFILE_TOP} functions by cumulative time "
     "(pstats) to stderr after the normal output"
@@ -47,7 +59,7 @@ PROFILE_HELP = (
 def _simulate(args: argparse.Namespace) -> None:
     from fhslam.errors import InputError
     from fhslam.io import write_carmen, write_relations, write_trajectory
-    from fhslam.io.files import check_outputs, output_batch
+    from fhslam.io.files import check_outputs, output_batch, output_name, writes_to_stdout
     from fhslam.metrics import sample_relations
     from fhslam.sim import OdometryNoise, load_world, simulate
     from fhslam.sim.simulate import check_scan_limit, is_closed_route
@@ -61,6 +73,7 @@ def _simulate(args: argparse.Namespace) -> None:
     check_outputs(
         {"--log": args.log, "--truth": args.truth, "--relations": args.relations},
         {"the input world file": None if builtin else args.world},
+        to_stdout=("--log", "--truth", "--relations"),
     )
     world = load_world(args.world)
     if args.laps > 1 and not is_closed_route(world.route):
@@ -90,8 +103,16 @@ def _simulate(args: argparse.Namespace) -> None:
                 f"{args.seed} (fhslam.metrics.sample_relations): timestamp1 timestamp2 x y z "
                 "roll pitch yaw",
             )
-    also = "" if args.relations is None else f", {len(rel[0])} relations to {args.relations}"
-    print(f"wrote {len(log)} scans to {args.log} and the true poses to {args.truth}{also}")
+    log_to, truth_to = output_name(args.log), output_name(args.truth)
+    also = (
+        ""
+        if args.relations is None
+        else f", {len(rel[0])} relations to {output_name(args.relations)}"
+    )
+    print(
+        f"wrote {len(log)} scans to {log_to} and the true poses to {truth_to}{also}",
+        file=sys.stderr if writes_to_stdout(args.log, args.truth, args.relations) else sys.stdout,
+    )
 
 
 def _load(args: argparse.Namespace):
@@ -154,7 +175,14 @@ def _evaluate(args: argparse.Namespace) -> None:
 
     from fhslam.errors import InputError
     from fhslam.evaluate import evaluate_relations, evaluate_truth
+    from fhslam.io.files import check_outputs
 
+    if args.plot is not None:  # before any work (_plot_errors checks the found relations)
+        reference = args.truth if args.relations is None else args.relations
+        check_outputs(
+            {"--plot": args.plot}, {"the trajectory": args.trajectory, "the reference": reference}
+        )
+        _plot_format(args.plot)
     if args.relations is not None:
         given = [
             opt
@@ -237,8 +265,9 @@ def _evaluate(args: argparse.Namespace) -> None:
 
 
 def _plot_errors(args: argparse.Namespace, reference: Path, max_diff: float) -> None:
-    """Draw ``fhslam evaluate``'s errors into the PNG ``args.plot``: against the relations
-    file or the truth file ``reference`` (already read once, so known to be good)."""
+    """Draw ``fhslam evaluate``'s errors into the picture ``args.plot`` (PNG, PDF or SVG, by
+    its extension): against the relations file or the truth file ``reference`` (already read
+    once, so known to be good)."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -258,7 +287,7 @@ def _plot_errors(args: argparse.Namespace, reference: Path, max_diff: float) -> 
         else:
             t_ref, ref = read_trajectory(reference)
             fig = pose_errors_figure(t, poses, t_ref, ref, max_diff, args.align, title)
-    _save_png(fig, args.plot)
+    _save_figure(fig, args.plot)
 
 
 def _check_delta(trajectory: Path, truth: Path, max_diff: float, delta: int) -> None:
@@ -315,7 +344,7 @@ def _slam(args: argparse.Namespace) -> None:
     import fhslam.datasets  # noqa: F401  (imported before --profile starts: not what it shows)
     from fhslam.errors import InputError, InputWarning
     from fhslam.io import write_graph, write_map, write_trajectory
-    from fhslam.io.files import check_outputs, output_batch
+    from fhslam.io.files import check_outputs, output_batch, output_name, writes_to_stdout
     from fhslam.pipeline import keyframe_graph, make_backend, run_backend, run_slam
 
     if args.graph is not None and args.method != "graph":
@@ -337,12 +366,16 @@ def _slam(args: argparse.Namespace) -> None:
             "--plot": args.plot,
         },
         {"the input log": args.log},
+        to_stdout=("--trajectory", "--map", "--graph"),
     )
+    _plot_format(args.plot)
+    # an output on standard output gets it alone: the messages go to stderr then
+    report = sys.stderr if writes_to_stdout(args.trajectory, args.map, args.graph) else sys.stdout
     with _profiling(args.profile):
         log = _load(args)
         log, degraded = _degraded(log, args)
         if degraded:
-            print(f"{args.log}: {degraded}")
+            print(f"{args.log}: {degraded}", file=report)
         if len(log) == 1:
             warnings.warn(
                 f"{args.log}: a single scan: nothing to match it with; the trajectory is its "
@@ -371,20 +404,23 @@ def _slam(args: argparse.Namespace) -> None:
                 + (f" ({degraded})" if degraded else "")
                 + ": timestamp x y theta",
             )
-            wrote = [f"{len(result.poses)} poses to {args.trajectory}"]
+            wrote = [f"{len(result.poses)} poses to {output_name(args.trajectory)}"]
             if args.map is not None:
                 write_map(args.map, result.map)
-                wrote.append(f"{len(result.map)} map lines to {args.map}")
+                wrote.append(f"{len(result.map)} map lines to {output_name(args.map)}")
             if args.graph is not None:
                 write_graph(args.graph, graph)
                 wrote.append(
                     f"{len(graph)} keyframes and {len(graph.active)} loop closures "
-                    f"({graph.n_active} active) to {args.graph}"
+                    f"({graph.n_active} active) to {output_name(args.graph)}"
                 )
             if args.plot is not None:
                 _write_plot(args.plot, log, result, args.method, graph)
                 wrote.append(f"a picture of the run to {args.plot}")
-        print("wrote " + ", ".join(wrote[:-1]) + (" and " if len(wrote) > 1 else "") + wrote[-1])
+        print(
+            "wrote " + ", ".join(wrote[:-1]) + (" and " if len(wrote) > 1 else "") + wrote[-1],
+            file=report,
+        )
 
 
 def _graph_params(pairs: list[str]):
@@ -394,7 +430,7 @@ def _graph_params(pairs: list[str]):
     import math
     from dataclasses import fields
 
-    from fhslam.errors import InputError
+    from fhslam.errors import InputError, ParameterError
     from fhslam.slam import GraphSlamParams
     from fhslam.slam.tracker import TrackerParams
 
@@ -435,6 +471,10 @@ def _graph_params(pairs: list[str]):
         if tracker:
             values["tracker"] = TrackerParams(**tracker)
         return GraphSlamParams(**values)
+    except ParameterError as e:  # out of its range: name the --set that gave it
+        key = ("tracker." if e.owner == "TrackerParams" else "") + e.name
+        given = [p for p in pairs if p.partition("=")[0].strip() == key]
+        raise InputError(f"--set {given[-1] if given else key!r}: {e}") from None
     except ValueError as e:
         raise InputError(f"--set: {e}") from None
 
@@ -466,28 +506,66 @@ def _degraded(log, args: argparse.Namespace):
     return log, ", ".join(done)
 
 
-def _save_png(fig, path: Path) -> None:
-    """Write a figure as the PNG ``path`` (whole or not at all), then close it."""
+PLOT_FORMATS = {".png": "png", ".pdf": "pdf", ".svg": "svg"}
+"""The formats of a picture (``--plot``), by the extension of its file name."""
+
+_PLOT_METADATA = {
+    "png": {"Software": None},
+    "pdf": {"Creator": None, "Producer": None, "CreationDate": None},
+    "svg": {"Creator": None, "Date": None},
+}
+"""No date and no matplotlib version in a picture: one figure, the same bytes."""
+
+
+def _plot_format(path: Path | None, option: str = "--plot") -> str | None:
+    """The format of the picture ``path`` (:data:`PLOT_FORMATS`), ``None`` without one.
+
+    Raises
+    ------
+    InputError
+        Naming ``option``, the path and the formats, for any other extension or none: call
+        it before any work.
+    """
+    from fhslam.errors import InputError
+
+    if path is None:
+        return None
+    suffix = Path(path).suffix
+    fmt = PLOT_FORMATS.get(suffix.lower())
+    if fmt is None:
+        has = f"not {suffix}" if suffix else "it has none"
+        raise InputError(
+            f"{option} {path}: the picture's format is given by the file name's extension, "
+            f"one of {', '.join(PLOT_FORMATS)} ({has}); nothing was written"
+        )
+    return fmt
+
+
+def _save_figure(fig, path: Path) -> None:
+    """Write a figure to ``path`` (whole or not at all) in the format of its extension
+    (:func:`_plot_format`: PNG at 100 dpi, PDF or SVG), then close it."""
     import matplotlib.pyplot as plt
 
     from fhslam.io.files import atomic_output
 
     try:
-        with atomic_output(path, "wb") as f:
-            fig.savefig(f, format="png", dpi=100, bbox_inches="tight", metadata={"Software": None})
+        fmt = _plot_format(path)
+        with atomic_output(path, "wb") as f, plt.rc_context({"svg.hashsalt": "fhslam"}):
+            fig.savefig(f, format=fmt, dpi=100, bbox_inches="tight", metadata=_PLOT_METADATA[fmt])
     finally:
         plt.close(fig)
 
 
 def _write_plot(path: Path, log, result, method: str, graph) -> None:
-    """Draw the run (:func:`fhslam.figures.slam_run_figure`) into the PNG ``path``."""
+    """Draw the run (:func:`fhslam.figures.slam_run_figure`) into the picture ``path`` (PNG,
+    PDF or SVG, by its extension)."""
     import matplotlib
 
     matplotlib.use("Agg")
 
     from fhslam.figures import slam_run_figure
 
-    _save_png(slam_run_figure(log, result, method, graph), path)
+    _save_figure(slam_run_figure(log, result, method, graph), path)
 
 
 def _bench(args: argparse.Namespace) -> None:
@@ -653,6 +731,7 @@ def build_parser() -> argparse.ArgumentParser:
         prog="fhslam",
         description="Fast-Hough-transform line SLAM for 2D laser scans (teaching workbook).",
     )
+    parser.add_argument("--debug", action="store_true", help=DEBUG_HELP)
     sub = parser.add_subparsers(dest="command", required=True)
 
     p = sub.add_parser("simulate", help="simulate a world: CARMEN log plus ground truth")
@@ -709,8 +788,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument(
         "--plot",
         type=Path,
-        help="output PNG: the map, the trajectory and the odometry (the truth where the log "
-        "has it; a graph run's loop closures)",
+        help="output picture (PNG, PDF or SVG by its extension): the map, the trajectory and "
+        "the odometry (the truth where the log has it; a graph run's loop closures)",
     )
     p.add_argument(
         "--set",
@@ -791,8 +870,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument(
         "--plot",
         type=Path,
-        help="output PNG: each relation's error over the run, coloured by the time between "
-        "its poses (--relations); the trajectory and each pose's error over time (--truth)",
+        help="output picture (PNG, PDF or SVG by its extension): each relation's error over "
+        "the run, coloured by the time between its poses (--relations); the trajectory and "
+        "each pose's error over time (--truth)",
     )
     p.set_defaults(run=_evaluate)
 
@@ -912,7 +992,8 @@ def build_parser() -> argparse.ArgumentParser:
         type=Path,
         metavar="RUNS.png",
         help="--log: draw every run's relation error against the run on the log as read and "
-        "issue 10's bound (fhslam.figures.sweep_errors_figure)",
+        "the robustness bound, 25 %% or 1 cm (fhslam.figures.sweep_errors_figure; PNG, PDF or "
+        "SVG by the extension)",
     )
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     g = p.add_argument_group(
@@ -951,7 +1032,8 @@ def build_parser() -> argparse.ArgumentParser:
         help="run the notebooks and write them back with fresh outputs and paired .py sources",
         description="Execute each notebook (all of NOTEBOOKS, or those whose names start with "
         "the numbers given) in a fresh kernel, in its own folder, and write it back with its "
-        "new outputs and its paired plain-text source (NN_topic.py, jupytext percent format). "
+        "new outputs and its paired plain-text source (NN_topic.py, jupytext percent format), "
+        "only where an output changed (measured times and widget ids do not count). "
         "Prints each notebook's Run All time and its slowest cell. A cell that raises stops "
         "the run with a one-line error naming the notebook and the cell; that notebook is "
         "left as it was. With --pair-only, nothing is run: only the .py sources are written.",
@@ -968,13 +1050,17 @@ def build_parser() -> argparse.ArgumentParser:
     )
     p.add_argument("--pair-only", action="store_true", help="write the .py sources, run nothing")
     p.set_defaults(run=_run_notebooks)
+    for command in sub.choices.values():  # also after the command; SUPPRESS: keep one before
+        command.add_argument(
+            "--debug", action="store_true", default=argparse.SUPPRESS, help=DEBUG_HELP
+        )
     return parser
 
 
 def _run_notebooks(args: argparse.Namespace) -> None:
     from fhslam.errors import InputError
     from fhslam.io.files import check_folder_writable
-    from fhslam.workbook import notebooks_in, pair, run_notebook
+    from fhslam.workbook import notebooks_in, pair, paired_path, run_notebook
 
     found = notebooks_in(args.notebooks)
     chosen = [p for p in found if not args.only or any(p.name.startswith(n) for n in args.only)]
@@ -986,7 +1072,10 @@ def _run_notebooks(args: argparse.Namespace) -> None:
     for path in chosen:
         args.in_progress = path  # named by main() if interrupted: left as it was
         if args.pair_only:
-            print(f"{pair(path)}: written")
+            py = paired_path(path)
+            before = py.read_text() if py.exists() else None
+            pair(path)  # writes the .py only where it differs
+            print(f"{py}: {'up to date' if py.read_text() == before else 'written'}")
         else:
             print(run_notebook(path, timeout=args.timeout), flush=True)
     args.in_progress = None
@@ -1068,6 +1157,7 @@ def _log_sweep(args: argparse.Namespace, methods: list[str], params) -> None:
     check_outputs(
         {"--out": args.out, "--plot": args.plot}, {"--log": args.log, "--relations": args.relations}
     )
+    _plot_format(args.plot)
     rows = robustness.log_sweep(
         args.log,
         args.relations,
@@ -1093,7 +1183,7 @@ def _log_sweep(args: argparse.Namespace, methods: list[str], params) -> None:
         degraded = next((r for r in rows if not r.reference), rows[0])
         title = f"{rows[0].log}: {robustness.degradation_text(degraded)}"
         bounds = robustness.RELATIVE_BOUND, robustness.ABSOLUTE_BOUND
-        _save_png(sweep_errors_figure(rows, *bounds, title), args.plot)
+        _save_figure(sweep_errors_figure(rows, *bounds, title), args.plot)
         print(f"wrote a picture of the runs to {args.plot}")
 
 
@@ -1139,9 +1229,14 @@ def _interrupted(args: argparse.Namespace) -> str:
 
 
 def main(argv: list[str] | None = None) -> int:
-    from fhslam.errors import InputError
-    from fhslam.io.files import interrupted_before_output, watch_interrupts
+    with warnings.catch_warnings():  # a warning on import (numba's cache): one line too
+        warnings.showwarning = _show_warning
+        from fhslam.errors import InputError
+        from fhslam.io.files import interrupted_before_output, watch_interrupts
 
+    for stream in (sys.stdout, sys.stderr):  # a path the locale cannot encode: escaped
+        if getattr(stream, "errors", None) == "strict" and hasattr(stream, "reconfigure"):
+            stream.reconfigure(errors="backslashreplace")
     args = build_parser().parse_args(argv)
     try:
         with watch_interrupts(), warnings.catch_warnings():
@@ -1150,17 +1245,45 @@ def main(argv: list[str] | None = None) -> int:
             args.run(args)
             if interrupted_before_output():  # Ctrl-C swallowed somewhere (watch_interrupts)
                 raise KeyboardInterrupt
-    except InputError as e:  # bad input; anything else is a bug and keeps its traceback
+    except InputError as e:  # bad input; anything else is a bug (below)
         message = " ".join(str(e).split())  # one line, whatever the message
         print(f"fhslam: error: {message}", file=sys.stderr)
         return EXIT_BAD_INPUT
-    except BaseException as e:  # Ctrl-C: the outputs' temporary files are already removed
-        if not _after_interrupt(e):
-            raise
+    except BaseException as e:  # the outputs' temporary files are already removed
+        if isinstance(e, BrokenPipeError) and _reader_gone(sys.stdout):  # `... | head -1`
+            return EXIT_BROKEN_PIPE
         sys.stdout.flush()
-        print(f"fhslam: {_interrupted(args)}", file=sys.stderr)
-        return EXIT_INTERRUPTED
+        if _after_interrupt(e):  # Ctrl-C
+            print(f"fhslam: {_interrupted(args)}", file=sys.stderr)
+            return EXIT_INTERRUPTED
+        if args.debug or not isinstance(e, Exception):  # SystemExit, GeneratorExit: as they are
+            raise
+        message = " ".join(str(e).split())
+        print(
+            f"fhslam: internal error: {type(e).__name__}{': ' if message else ''}{message} "
+            "(please report it; run again with --debug for the traceback)",
+            file=sys.stderr,
+        )
+        return EXIT_INTERNAL_ERROR
     return 0
+
+
+def _reader_gone(stream) -> bool:
+    """Whether the reader of ``stream``, a pipe, has closed it; then anything still buffered
+    for it is dropped (Python would report it at exit). Unknown (a captured stream, no
+    ``select.poll``): False."""
+    import os
+    import select
+
+    try:
+        poll = select.poll()
+        poll.register(stream.fileno(), select.POLLOUT)
+        if not any(events & select.POLLERR for _, events in poll.poll(0)):
+            return False
+        os.dup2(os.open(os.devnull, os.O_WRONLY), stream.fileno())
+    except (AttributeError, OSError, ValueError):  # io.UnsupportedOperation is both
+        return False
+    return True
 
 
 def _after_interrupt(e: BaseException) -> bool:

@@ -5,40 +5,131 @@ Every reader of :mod:`fhslam` opens its file through :func:`input_path` and
 
 - a missing input is a :class:`~fhslam.errors.MissingInputError` naming the path, a directory
   or an unreadable file an :class:`~fhslam.errors.InputError`;
-- an output is written to a temporary file beside it and renamed into place only once
-  complete: a failed or interrupted write leaves no half-written file, and an output that
-  cannot be written is an :class:`~fhslam.errors.InputError` naming the path;
+- an output that is a regular file (or does not exist yet) is written to a temporary file
+  beside it and renamed into place only once complete: a failed or interrupted write leaves
+  no half-written file, and an output that cannot be written is an
+  :class:`~fhslam.errors.InputError` naming the path;
+- an output that exists and is not a regular file -- a device such as ``/dev/null``, a named
+  pipe (FIFO), a descriptor such as ``/dev/fd/3`` or ``/dev/stdout`` (also of a shell's
+  process substitution ``>(gzip > t.gz)``) -- is a *stream*: it is opened and written in
+  place, never replaced, renamed over or removed. Its content is kept in memory until complete
+  and then written in one go, so a failed writer sends it nothing; a failed write (``/dev/full``'s
+  "No space left on device", a closed pipe's "Broken pipe") is an InputError naming the path.
+  Opening a FIFO waits for its reader, as for any program. A socket cannot be opened: it is
+  refused naming the path;
+- the output ``-`` is standard output, a stream as above (a file named ``-`` is ``./-``);
+  text goes out as the same UTF-8 bytes a file would hold;
+- text is written as UTF-8; a file name's bytes that the locale could not decode (Python
+  keeps them as surrogate escapes, e.g. a name in UTF-8 under ``LC_ALL=C``) are written as
+  those bytes where they are UTF-8, and as ``\\xNN`` escapes where not, so every text output
+  is valid UTF-8;
 - a command checks its outputs with :func:`check_outputs` before it reads or computes
   anything: an output that is one of its inputs (or another output) is refused, so that no
   input is ever overwritten, and so is one that cannot be written (its folder missing or not
-  writable, checked by creating and removing a file there), so that no work is lost;
+  writable, checked by creating and removing a file there; a name too long for the file
+  system; a socket; ``-`` where the command does not allow it, or for two outputs), so that
+  no work is lost; a stream is checked without opening it, so a FIFO does not block the check;
 - a command that writes several files writes them inside :func:`output_batch`: each is
   written to its temporary file, and all are renamed into place only once every one is
   complete, so that a failure (or Ctrl-C) leaves none of them; :func:`output_folder` does the
-  same for a command that writes into a folder it may create.
+  same for a command that writes into a folder it may create. A stream in a batch cannot be
+  taken back: it is written when the batch commits, before the files are renamed, so a
+  failure or Ctrl-C before then sends it nothing, and a failed write to it leaves none of the
+  files; only a rename failing after it (the folder changed since the check) leaves the stream
+  written without the files.
 """
 
 from __future__ import annotations
 
+import codecs
+import errno
+import itertools
 import os
+import re
+import stat
+import sys
 import tempfile
-from collections.abc import Iterator
+from collections.abc import Collection, Iterator
 from contextlib import contextmanager, suppress
 from contextvars import ContextVar
+from dataclasses import dataclass, field
+from io import BytesIO, TextIOWrapper
 from pathlib import Path
 from typing import IO
 
 from fhslam.errors import InputError, MissingInputError
 
 __all__ = [
+    "STDOUT",
     "atomic_output",
     "check_folder_writable",
     "check_outputs",
     "input_path",
     "output_batch",
     "output_folder",
+    "output_name",
     "reading",
+    "writes_to_stdout",
 ]
+
+STDOUT = "-"
+"""The output name that means standard output."""
+
+ENCODING_ERRORS = "fhslam.filenames"
+"""The codec error handler of every text output (see the module docs)."""
+
+
+def _undecoded_bytes(e: UnicodeError) -> tuple[bytes, int]:
+    """Codec error handler :data:`ENCODING_ERRORS`: surrogate escapes (bytes a file name had
+    that the locale could not decode) become those bytes where they are UTF-8, ``\\xNN``
+    escapes where not; any other unencodable character a ``\\uNNNN`` escape."""
+    if not isinstance(e, UnicodeEncodeError):
+        raise e
+    out, raw = [], bytearray()
+    for c in e.object[e.start : e.end]:
+        if "\udc80" <= c <= "\udcff":
+            raw.append(ord(c) - 0xDC00)
+            continue
+        out.append(raw.decode("utf-8", "backslashreplace").encode("utf-8"))
+        out.append(c.encode("ascii", "backslashreplace"))
+        raw.clear()
+    out.append(raw.decode("utf-8", "backslashreplace").encode("utf-8"))
+    return b"".join(out), e.end
+
+
+codecs.register_error(ENCODING_ERRORS, _undecoded_bytes)
+
+
+def _is_stdout(path: object) -> bool:
+    """Whether ``path`` is :data:`STDOUT` (``"-"``, also as a Path)."""
+    return isinstance(path, str | os.PathLike) and os.fspath(path) == STDOUT
+
+
+def output_name(path: str | os.PathLike[str]) -> str:
+    """``path`` as a message names it: ``"standard output"`` for ``-``."""
+    return "standard output" if _is_stdout(path) else str(path)
+
+
+def writes_to_stdout(*paths: str | os.PathLike[str] | None) -> bool:
+    """Whether an output among ``paths`` goes to this process's standard output: ``-``, or a
+    name of the pipe or file that standard output is (``/dev/stdout``). A command prints its
+    messages to stderr then, so that they do not mix with the output (a terminal, where both
+    show, is not counted)."""
+    try:
+        out = os.fstat(sys.stdout.fileno())
+    except (AttributeError, OSError, ValueError):  # no real stdout (captured, closed)
+        out = None
+    for p in paths:
+        if p is None:
+            continue
+        if _is_stdout(p):
+            return True
+        if out is None or stat.S_ISCHR(out.st_mode):
+            continue
+        with suppress(OSError, ValueError):
+            if os.path.samestat(os.stat(p), out):
+                return True
+    return False
 
 
 def input_path(path: str | os.PathLike[str], what: str = "") -> Path:
@@ -49,11 +140,16 @@ def input_path(path: str | os.PathLike[str], what: str = "") -> Path:
     MissingInputError
         If nothing exists at ``path`` (the message says ``what`` was looked for).
     InputError
-        If ``path`` is a directory or another non-file.
+        If ``path`` is a directory or another non-file, or cannot be looked up (a name too
+        long for the file system).
     """
     p = Path(path)
     what = f"{what} file" if what else "file"
-    if not p.exists():
+    try:
+        exists = p.exists()
+    except OSError as e:
+        raise InputError(f"{p}: cannot read ({e.strerror or e})") from None
+    if not exists:
         raise MissingInputError(f"{p}: no such {what}", str(p))
     if not p.is_file():
         kind = "a directory" if p.is_dir() else "not a regular file"
@@ -71,6 +167,65 @@ def _same_file(a: Path, b: Path) -> bool:
     return a.resolve() == b.resolve()
 
 
+def _is_file(p: Path) -> bool:
+    """Whether ``p`` is a regular file (False where it cannot be looked up)."""
+    try:
+        return p.is_file()
+    except OSError:
+        return False
+
+
+_DESCRIPTOR_FOLDER = re.compile(r"/proc/(?:self|thread-self|\d+)(?:/task/\d+)?/fd")
+"""A process's folder of open descriptors, where ``/dev/fd`` and ``/dev/stdout`` lead."""
+
+
+def _names_a_descriptor(p: Path) -> bool:
+    """Whether ``p`` is, or leads through symbolic links to, an open descriptor of a process
+    (``/dev/fd/3``, ``/dev/stdout``, ``/proc/self/fd/1``): a stream, even where it is a
+    regular file, since its folder is no place for a temporary file."""
+    q = os.path.abspath(p)
+    for _ in range(40):  # the kernel's limit on links followed
+        folder = os.path.realpath(os.path.dirname(q))
+        if _DESCRIPTOR_FOLDER.fullmatch(folder):
+            return True
+        try:
+            link = os.readlink(q)
+        except OSError:  # not a link
+            return False
+        q = os.path.abspath(os.path.join(folder, link))
+    return False
+
+
+def _output_kind(p: Path, what: str) -> str:
+    """``"stream"`` if the output ``p`` exists and is not a regular file or names a
+    descriptor (written in place), ``"file"`` if it is a regular file or does not exist
+    (written to a temporary file and renamed); ``what`` names it in errors.
+
+    Raises
+    ------
+    InputError
+        If ``p`` is a directory or a socket, or cannot be looked up (a name too long).
+    """
+    try:
+        st = os.stat(p)
+    except (FileNotFoundError, NotADirectoryError):
+        return "file"  # a new file; its folder is checked where it is created
+    except OSError as e:
+        if e.errno == errno.ELOOP:  # a loop of links: replaced by the file, as a link is
+            return "file"
+        raise InputError(f"{what}: cannot write ({e.strerror or e})") from None
+    if stat.S_ISDIR(st.st_mode):
+        raise InputError(f"{what}: is a directory; give a file name for the output")
+    if stat.S_ISSOCK(st.st_mode):
+        raise InputError(
+            f"{what}: is a socket, which cannot be opened for writing; give a file, a pipe "
+            "or - (standard output)"
+        )
+    if not stat.S_ISREG(st.st_mode) or _names_a_descriptor(p):
+        return "stream"
+    return "file"
+
+
 def check_folder_writable(folder: str | os.PathLike[str], what: str) -> None:
     """Check that files can be created in the existing folder ``folder`` by creating and
     removing one there (permissions alone do not tell: root ignores them, an immutable or
@@ -83,9 +238,13 @@ def check_folder_writable(folder: str | os.PathLike[str], what: str) -> None:
         {folder})"``, ``"... ({folder} is not a folder)"``.
     """
     d = Path(folder)
-    if not d.exists():
+    try:
+        exists, is_dir = d.exists(), d.is_dir()
+    except OSError as e:
+        raise InputError(f"{what}: cannot write (folder {d}: {e.strerror or e})") from None
+    if not exists:
         raise InputError(f"{what}: cannot write (no such folder {d})")
-    if not d.is_dir():
+    if not is_dir:
         raise InputError(f"{what}: cannot write ({d} is not a folder)")
     try:
         fd, probe = tempfile.mkstemp(prefix=".fhslam-probe-", dir=d)
@@ -98,14 +257,18 @@ def check_folder_writable(folder: str | os.PathLike[str], what: str) -> None:
 def check_outputs(
     outputs: dict[str, str | os.PathLike[str] | None],
     inputs: dict[str, str | os.PathLike[str] | None],
+    to_stdout: Collection[str] = (),
 ) -> None:
     """Refuse outputs that would overwrite an input or each other, or cannot be written.
 
     ``outputs`` and ``inputs`` map how the user gave each path (an option such as
-    ``"--log"``, or a description such as ``"the world file"``) to the path; ``None``
+    ``"--log"``, or a description such as ``"the input world file"``) to the path; ``None``
     entries (an option not given, an input that is not a file, e.g. a built-in world's
     name) are skipped. Each output must name a file (not a directory) in an existing folder
-    where a file can be created (:func:`check_folder_writable`).
+    where a file can be created (:func:`check_folder_writable`), or an existing stream (a
+    device, a FIFO, a descriptor: accepted without opening it or probing its folder; two
+    outputs may name one character device, such as ``/dev/null``). ``-`` (standard output) is
+    accepted for the outputs named in ``to_stdout``, and for one output only.
 
     Raises
     ------
@@ -113,28 +276,42 @@ def check_outputs(
         Naming the output and what it would overwrite or why it cannot be written; call this
         before anything is read, computed or written.
     """
+    given = {what: p for what, p in outputs.items() if p is not None}
+    dashes = [what for what, p in given.items() if _is_stdout(p)]
+    for what in dashes:
+        if what not in to_stdout:
+            raise InputError(
+                f"{what} -: this output cannot go to standard output; give a file name "
+                "(./- for a file named -)"
+            )
+    if len(dashes) > 1:
+        raise InputError(
+            f"{' and '.join(f'{what} -' for what in dashes)}: only one output can go to "
+            "standard output (nothing was written)"
+        )
+    files = {what: Path(p) for what, p in given.items() if not _is_stdout(p)}
     seen: list[tuple[str, Path]] = [
-        (what, Path(p)) for what, p in inputs.items() if p is not None and Path(p).is_file()
+        (what, Path(p)) for what, p in inputs.items() if p is not None and _is_file(Path(p))
     ]
-    for what, p in outputs.items():
-        if p is None:
-            continue
-        path = Path(p)
+    for what, path in files.items():
         for other, q in seen:
-            if _same_file(path, q):
+            if _same_file(path, q) and not _is_char_device(path):
                 role = "also given as" if other.startswith("--") else "is"
                 raise InputError(
                     f"{what} {path}: {role} {other}; an output must not overwrite an input "
                     "or another output (nothing was written)"
                 )
         seen.append((what, path))
-    for what, p in outputs.items():
-        if p is None:
-            continue
-        path = Path(p)
-        if path.is_dir():
-            raise InputError(f"{what} {path}: is a directory; give a file name for the output")
-        check_folder_writable(path.parent, f"{what} {path}")
+    for what, path in files.items():
+        if _output_kind(path, f"{what} {path}") == "file":
+            check_folder_writable(path.parent, f"{what} {path}")
+
+
+def _is_char_device(p: Path) -> bool:
+    try:
+        return stat.S_ISCHR(os.stat(p).st_mode)
+    except OSError:
+        return False
 
 
 @contextmanager
@@ -149,8 +326,17 @@ def reading(path: str | os.PathLike[str]) -> Iterator[None]:
         raise InputError(f"{path}: cannot read ({e.strerror or e})") from None
 
 
-_BATCH: ContextVar[list[tuple[Path, Path]] | None] = ContextVar("_BATCH", default=None)
-"""The open :func:`output_batch`'s completed temporary files and their targets, or None."""
+@dataclass
+class _Batch:
+    """An open :func:`output_batch`: its completed temporary files with their targets, and
+    its streams' targets with their content, in the order written."""
+
+    renames: list[tuple[Path, Path]] = field(default_factory=list)
+    streams: list[tuple[str | Path, bytes]] = field(default_factory=list)
+
+
+_BATCH: ContextVar[_Batch | None] = ContextVar("_BATCH", default=None)
+"""The open :func:`output_batch`, or None."""
 
 _INTERRUPTED = [False]
 """Whether Ctrl-C was pressed since :func:`watch_interrupts` began (a list: set in place)."""
@@ -221,16 +407,21 @@ def output_batch() -> Iterator[None]:
     is removed and no output appears. Should a rename itself fail (the folder changed since),
     the outputs renamed before it are removed again and the error names the path. Batches
     nest: an inner one joins the outer.
+
+    A stream (a device, a pipe, standard output: see the module docs) cannot be taken back:
+    its content is held until the block ends normally and then written, before the renames; if
+    that write fails, no file is renamed. Only a rename failing after it leaves the stream
+    written without the files.
     """
     if _BATCH.get() is not None:
         yield
         return
-    pending: list[tuple[Path, Path]] = []
-    token = _BATCH.set(pending)
+    batch = _Batch()
+    token = _BATCH.set(batch)
     try:
         yield
     except BaseException:
-        for tmp, _ in pending:
+        for tmp, _ in batch.renames:
             tmp.unlink(missing_ok=True)
         raise
     finally:
@@ -238,7 +429,10 @@ def output_batch() -> Iterator[None]:
     done: list[Path] = []
     try:
         _commit_allowed()
-        for tmp, target in pending:
+        for target, data in batch.streams:
+            _write_stream(target, data)
+            _COMMITTED[0] += 1
+        for tmp, target in batch.renames:
             try:
                 os.replace(tmp, target)
             except OSError as e:
@@ -246,7 +440,7 @@ def output_batch() -> Iterator[None]:
             done.append(target)
             _COMMITTED[0] += 1
     except BaseException:
-        for tmp, _ in pending:
+        for tmp, _ in batch.renames:
             tmp.unlink(missing_ok=True)
         for target in done:
             target.unlink(missing_ok=True)
@@ -302,23 +496,30 @@ def _remove_empty(folder: Path) -> None:
 def atomic_output(path: str | os.PathLike[str], mode: str = "w") -> Iterator[IO]:
     """Open ``path`` for writing so that it appears only complete (see the module docs).
 
-    Yields a file object (text, UTF-8, for ``mode="w"``; bytes for ``"wb"``) on a temporary
-    file in the same folder, renamed to ``path`` when the ``with`` block ends normally (or,
-    inside an :func:`output_batch`, when the batch ends); removed if it raises (including
-    :class:`KeyboardInterrupt`).
+    Yields a file object (text, UTF-8, for ``mode="w"``; bytes for ``"wb"``). For a regular
+    file (or a new one) it is a temporary file in the same folder, renamed to ``path`` when
+    the ``with`` block ends normally (or, inside an :func:`output_batch`, when the batch
+    ends), and removed if it raises (including :class:`KeyboardInterrupt`). For a stream (a
+    device, a FIFO, a descriptor such as ``/dev/fd/3``, or ``-`` for standard output) it is a
+    buffer in memory, written to ``path`` in place when the block (or the batch) ends
+    normally, and dropped if it raises.
 
     Raises
     ------
     InputError
-        If the file cannot be created or written (no such folder, permission denied, disk
-        full), naming ``path``.
+        If the output cannot be created or written (no such folder, permission denied, disk
+        full, a closed pipe, a name too long), naming ``path``.
     """
+    if _is_stdout(path):
+        yield from _stream_output(STDOUT, mode)
+        return
     p = Path(path)
-    if p.is_dir():
-        raise InputError(f"{p}: is a directory; give a file name for the output")
-    tmp = p.with_name(f".{p.name}.{os.getpid()}.tmp")
+    if _output_kind(p, str(p)) == "stream":
+        yield from _stream_output(p, mode)
+        return
+    tmp = _temporary_name(p)
     try:
-        f = open(tmp, mode, encoding=None if "b" in mode else "utf-8")  # noqa: SIM115
+        f = open(tmp, mode, **_text_options(mode))  # noqa: SIM115
     except OSError as e:
         raise InputError(f"{p}: cannot write ({e.strerror or e})") from None
     try:
@@ -330,10 +531,93 @@ def atomic_output(path: str | os.PathLike[str], mode: str = "w") -> Iterator[IO]
             os.replace(tmp, p)
             _COMMITTED[0] += 1
         else:
-            batch.append((tmp, p))
+            batch.renames.append((tmp, p))
     except OSError as e:
         tmp.unlink(missing_ok=True)
         raise InputError(f"{p}: cannot write ({e.strerror or e})") from None
     except BaseException:
         tmp.unlink(missing_ok=True)
         raise
+
+
+def _text_options(mode: str) -> dict[str, str | None]:
+    """``open``'s encoding options for ``mode``: UTF-8 for text (see the module docs)."""
+    return {} if "b" in mode else {"encoding": "utf-8", "errors": ENCODING_ERRORS}
+
+
+_SHORT_NAMES = itertools.count()
+"""Numbers the temporary files of outputs whose own name is near the length limit."""
+
+
+def _temporary_name(p: Path) -> Path:
+    """The temporary file of the output ``p``: ``.{name}.{pid}.tmp`` beside it, or, where that
+    name would be too long for the file system, ``.fhslam.{pid}.{n}.tmp``."""
+    name = f".{p.name}.{os.getpid()}.tmp"
+    try:
+        limit = os.pathconf(p.parent, "PC_NAME_MAX")
+    except (OSError, ValueError):
+        limit = 255
+    if len(os.fsencode(name)) > limit:
+        name = f".fhslam.{os.getpid()}.{next(_SHORT_NAMES)}.tmp"
+    return p.with_name(name)
+
+
+def _stream_output(target: str | Path, mode: str) -> Iterator[IO]:
+    """:func:`atomic_output`'s body for a stream: a buffer, written to ``target`` when the
+    ``with`` block (or the open batch) ends normally."""
+    buffer = BytesIO()
+    f: IO = (
+        buffer if "b" in mode else TextIOWrapper(buffer, write_through=True, **_text_options(mode))
+    )
+    yield f
+    f.flush()
+    data = buffer.getvalue()
+    batch = _BATCH.get()
+    if batch is None:
+        _commit_allowed()
+        _write_stream(target, data)
+        _COMMITTED[0] += 1
+    else:
+        batch.streams.append((target, data))
+
+
+def _write_stream(target: str | Path, data: bytes) -> None:
+    """Write ``data`` to the stream ``target`` in place (``-``: standard output, not closed).
+
+    Raises
+    ------
+    InputError
+        ``"{target}: cannot write ({reason})"``, e.g. no space left on the device, a broken
+        pipe, or a path that cannot be opened.
+    """
+    if _is_stdout(target):
+        try:
+            sys.stdout.flush()
+            out = getattr(sys.stdout, "buffer", None)
+            if out is None:  # a text-only stand-in (tests): the same text
+                sys.stdout.write(data.decode("utf-8", "surrogateescape"))
+            else:
+                out.write(data)
+            sys.stdout.flush()
+        except OSError as e:
+            _abandon_stdout()
+            raise InputError(f"standard output: cannot write ({e.strerror or e})") from None
+        return
+    try:
+        with open(target, "wb") as f:
+            f.write(data)
+    except OSError as e:
+        raise InputError(f"{target}: cannot write ({e.strerror or e})") from None
+
+
+def _abandon_stdout() -> None:
+    """Point standard output at the null device after a write to it failed (a closed pipe, a
+    full disk), so that Python's flush at exit does not fail again with a traceback-like
+    "Exception ignored" message."""
+    with suppress(AttributeError, OSError, ValueError):
+        fd = sys.stdout.fileno()
+        null = os.open(os.devnull, os.O_WRONLY)
+        try:
+            os.dup2(null, fd)
+        finally:
+            os.close(null)

@@ -9,8 +9,9 @@ line is ``rho = x cos(theta) + y sin(theta)`` (paper eq. (1)) with ``rho >= 0`` 
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
 from numpy.typing import ArrayLike, NDArray
+
+from fhslam._numba import njit
 
 TWO_PI = 2.0 * np.pi
 

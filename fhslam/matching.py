@@ -28,10 +28,12 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import ClassVar
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from fhslam.errors import Range, check_ranges
 from fhslam.geometry import (
     as_pose,
     normalize_line,
@@ -63,15 +65,16 @@ class MatchParams:
     max_distance: float = 0.15
     min_overlap: float = 0.0
 
+    RANGES: ClassVar[dict[str, Range]] = {
+        "max_angle_deg": Range(0.0, 90.0, open_low=True, cap=False, unit="degrees"),
+        "max_distance": Range(0.0, 100.0, open_low=True, unit="m"),
+        "min_overlap": Range(-100.0, 100.0, unit="m"),
+    }
+    """The range of each number (:class:`fhslam.errors.Range`), checked when the parameters
+    are made; "at most": a limit of plausibility."""
+
     def __post_init__(self) -> None:
-        if not (0 < self.max_angle_deg <= 90):
-            raise ValueError(
-                f"MatchParams.max_angle_deg must be in (0, 90], got {self.max_angle_deg}"
-            )
-        if not (np.isfinite(self.max_distance) and self.max_distance > 0):
-            raise ValueError(f"MatchParams.max_distance must be > 0, got {self.max_distance}")
-        if not np.isfinite(self.min_overlap):
-            raise ValueError(f"MatchParams.min_overlap must be finite, got {self.min_overlap}")
+        check_ranges(self, self.RANGES)
 
 
 @dataclass(frozen=True)

@@ -20,11 +20,10 @@ from dataclasses import dataclass
 
 import numpy as np
 from llvmlite import ir
-from numba import njit, types
-from numba.core.extending import intrinsic
 from numpy.typing import ArrayLike, NDArray
 from scipy.spatial import cKDTree
 
+from fhslam._numba import intrinsic, njit, types
 from fhslam.geometry import as_points, as_pose, tls_normal_angle, transform_points
 
 __all__ = [

@@ -485,8 +485,10 @@ def _evaluate_cases() -> list[Case]:
                   "trajectory-three-columns"),
         _evaluate("est.txt", TRUTH.replace("0.4 0.2 0 0", "0.4 1e999 0 0"), ["est.txt:3"],
                   "trajectory-inf"),
-        _evaluate("est.txt", TRUTH.replace("0.4 0.2", "0.2 0.2"), ["est.txt:3"],
-                  "trajectory-repeated-time", expect="warn"),
+        _evaluate("est.txt", TRUTH.replace("0.4 0.2", "0.2 0.1"), ["est.txt:3"],
+                  "trajectory-repeated-time", expect="warn"),  # the same pose twice
+        _evaluate("est.txt", TRUTH.replace("0.4 0.2", "0.2 0.2"), ["est.txt:3", "line 2"],
+                  "trajectory-repeated-time-other-pose"),
         _evaluate("est.txt", TRUTH.replace("0.4 0.2", "0.1 0.2"), ["est.txt:3"],
                   "trajectory-time-backwards", expect="warn"),
         _evaluate("truth.txt", "".join(f"{100 + k} 0 0 0\n" for k in range(10)), ["truth.txt"],
@@ -549,6 +551,12 @@ def _world_cases() -> list[Case]:
         _simulate(w, _world().replace("[1, 1]", "[NaN, 1]"), [w], "world-route-nan"),
         _simulate(w, _world().replace("[0, 0, 6, 0]", "[0, 0, Infinity, 0]"), [w],
                   "world-wall-inf"),
+        _simulate(w, _world().replace("[0, 0, 6, 0]", f"[0, 0, {'9' * 5000}, 0]"), [w],
+                  "world-wall-5000-digits"),
+        _simulate(w, _world().replace("[0, 0, 6, 0]", "[0, 0, 1e400, 0]"), [w],
+                  "world-wall-1e400"),
+        _simulate(w, _world(walls="@").replace('"@"', "[" * 100_000 + "]" * 100_000),
+                  [w, "nested"], "world-nested-100000-deep"),
         Case("world-missing", ["simulate", "{d}/none.json", "--log", "{d}/o.clf",
              "--truth", "{d}/o.txt"], {}, "error", ["none.json"]),
         Case("world-unknown-builtin", ["simulate", "nosuchworld", "--log", "{d}/o.clf",
@@ -579,8 +587,8 @@ CASES += _bench_cases()
 # Running a case
 
 
-class _Timeout(Exception):
-    pass
+class _Timeout(BaseException):
+    """Not an Exception, which the command reports as an internal error (exit status 1)."""
 
 
 def _alarm(signum, frame):

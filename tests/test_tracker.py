@@ -49,7 +49,7 @@ def test_an_odometry_glitch_is_absorbed(paper_log, extra):
 
 
 def test_tracker_parameters_are_checked():
-    with pytest.raises(ValueError, match="resolution must be > 0"):
+    with pytest.raises(ValueError, match=r"resolution must be >= 0\.01"):
         TrackerParams(resolution=0.0)
     with pytest.raises(ValueError, match=r"min_score must be in \[0, 1\]"):
         TrackerParams(min_score=2.0)

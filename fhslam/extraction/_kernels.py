@@ -10,8 +10,8 @@ the whole scan takes tens of µs (see ``fhslam bench``).
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
 
+from fhslam._numba import njit
 from fhslam.geometry import tls_normal_angle
 
 _JIT = {"cache": True, "nogil": True, "fastmath": False}

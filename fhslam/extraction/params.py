@@ -3,11 +3,15 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Literal
+from typing import ClassVar, Literal
 
-import numpy as np
+from fhslam.errors import ParameterError, Range, check_ranges
 
 __all__ = ["ExtractionParams"]
+
+MAX_DENSIFY = 1000
+"""Most points :attr:`ExtractionParams.densify_step` may fill into one gap between
+neighbouring scan points (the gap is at most ``cluster_gap``)."""
 
 
 @dataclass(frozen=True)
@@ -84,26 +88,38 @@ class ExtractionParams:
     drop_lone_points: bool = True
     seed: int = 0
 
+    RANGES: ClassVar[dict[str, Range]] = {
+        "cluster_gap": Range(0.0, 10.0, open_low=True, unit="m"),
+        "densify_step": Range(0.0, 10.0, unit="m"),
+        "n_pairs": Range(1, 100_000, integer=True),
+        "min_pair_dist": Range(0.0, 100.0, unit="m"),
+        "angle_bin_deg": Range(0.01, 90.0, unit="degrees"),
+        "window_deg": Range(0.0, 90.0, cap=False, unit="degrees"),
+        "theta_step_deg": Range(0.01, 90.0, unit="degrees"),
+        "rho_step": Range(0.001, 10.0, unit="m"),
+        "inlier_dist": Range(0.0, 10.0, open_low=True, unit="m"),
+        "refine_iterations": Range(0, 100, integer=True),
+        "min_points": Range(2, 1_000_000, integer=True),
+        "min_length": Range(0.0, 1000.0, unit="m"),
+        "max_lines_per_cluster": Range(1, 10_000, integer=True),
+        "max_peaks": Range(1, 1000, integer=True),
+        "seed": Range(0, 2**63 - 1, integer=True),
+    }
+    """The range of each number (:class:`fhslam.errors.Range`), checked when the parameters
+    are made. "At most" is a limit of plausibility, and so are the smallest steps: a
+    histogram bin or accumulator step finer than that holds millions of cells. Besides,
+    ``densify_step`` is 0 (off) or at least ``cluster_gap`` / :data:`MAX_DENSIFY` (the
+    points filled into one gap)."""
+
     def __post_init__(self) -> None:
-        positive = ("cluster_gap", "angle_bin_deg", "theta_step_deg", "rho_step", "inlier_dist")
-        for name in positive:
-            v = getattr(self, name)
-            if not (np.isfinite(v) and v > 0):
-                raise ValueError(f"ExtractionParams.{name} must be a positive number, got {v!r}")
-        if not (np.isfinite(self.densify_step) and self.densify_step >= 0):
-            raise ValueError(f"ExtractionParams.densify_step must be >= 0, got {self.densify_step}")
         if self.pairs not in ("random", "all"):
-            raise ValueError(
-                f"ExtractionParams.pairs must be 'random' or 'all', got {self.pairs!r}"
-            )
-        if self.min_points < 2:
-            raise ValueError(f"ExtractionParams.min_points must be >= 2, got {self.min_points}")
-        if (
-            self.window_deg < 0
-            or self.n_pairs < 1
-            or self.refine_iterations < 0
-            or self.max_peaks < 1
-        ):
-            raise ValueError(
-                "ExtractionParams: window_deg, n_pairs, refine_iterations out of range"
+            raise ParameterError("ExtractionParams", "pairs", self.pairs, "'random' or 'all'")
+        check_ranges(self, self.RANGES)
+        if 0 < self.densify_step < self.cluster_gap / MAX_DENSIFY:
+            raise ParameterError(
+                "ExtractionParams",
+                "densify_step",
+                self.densify_step,
+                f"0 (off) or at least cluster_gap / {MAX_DENSIFY} = "
+                f"{self.cluster_gap / MAX_DENSIFY:g} m",
             )

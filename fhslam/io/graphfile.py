@@ -33,6 +33,7 @@ from numpy.typing import NDArray
 
 from fhslam.errors import InputError
 from fhslam.io.files import atomic_output, input_path, reading
+from fhslam.io.jsontext import parse_json
 
 __all__ = ["GraphFormatError", "KeyframeGraph", "read_graph", "write_graph"]
 
@@ -198,17 +199,17 @@ def read_graph(path: str | PathLike[str]) -> KeyframeGraph:
         ``"loops"`` list, or an entry is malformed: a keyframe that is not four finite
         numbers, a loop closure without a key, with an index that is not a keyframe's or
         an ``old`` not older than its ``new``, a non-boolean ``active`` or a non-finite
-        ``score`` (naming the entry, ``keyframes[i]`` or ``loops[i]``).
+        ``score`` (naming the entry, ``keyframes[i]`` or ``loops[i]``, and for ``NaN``,
+        ``Infinity`` or a number beyond the largest float the text line too,
+        :func:`fhslam.io.jsontext.parse_json`).
     """
     path = input_path(path, "keyframe-graph")
     try:
         with reading(path):
             text = path.read_text(encoding="utf-8")
-        data = json.loads(text)
-    except json.JSONDecodeError as e:
-        raise GraphFormatError(f"{path}:{e.lineno}: not valid JSON ({e.msg})") from None
     except UnicodeDecodeError as e:
         raise GraphFormatError(f"{path}: not a text file ({e.reason})") from None
+    data = parse_json(text, path, GraphFormatError)
     if not isinstance(data, dict) or "keyframes" not in data or "loops" not in data:
         raise GraphFormatError(
             f'{path}: expected a JSON object {{"keyframes": [...], "loops": [...]}}'

@@ -24,6 +24,7 @@ from numpy.typing import ArrayLike
 from fhslam.errors import InputError
 from fhslam.geometry import line_through
 from fhslam.io.files import atomic_output, input_path, reading
+from fhslam.io.jsontext import parse_json
 from fhslam.lines import Line
 
 _KEYS = ("sp", "ep", "rho", "theta", "n")
@@ -32,6 +33,10 @@ MAX_COORDINATE = 1e6
 """Largest ``|x|``, ``|y|`` or ``rho`` a map file may hold, metres: a thousand kilometres is
 no building, and a coordinate near the float limit (``1e308``) overflows any length or
 distance computed from it (the map error came out ``inf``)."""
+
+
+MAX_POINTS = 2**63 - 1
+"""Largest ``n`` a map file may hold: what a 64-bit integer holds."""
 
 
 class MapFormatError(InputError):
@@ -113,8 +118,16 @@ def _line(d: Any, where: str) -> Line:
     rho = _number(d["rho"], "'rho'", where)
     theta = _number(d["theta"], "'theta'", where)
     n = d["n"]
-    if isinstance(n, bool) or not isinstance(n, int | float) or n != int(n) or n < 0:
-        raise MapFormatError(f"{where}: 'n' must be a non-negative integer, got {n!r}")
+    if (
+        isinstance(n, bool)
+        or not isinstance(n, int | float)
+        or not math.isfinite(n)
+        or n != int(n)
+        or not 0 <= n <= MAX_POINTS
+    ):
+        raise MapFormatError(
+            f"{where}: 'n' must be a whole number from 0 to {MAX_POINTS}, got {n!r}"
+        )
     if rho < 0:
         raise MapFormatError(f"{where}: 'rho' must be >= 0 (Hessian normal form), got {rho!r}")
     if rho > MAX_COORDINATE:
@@ -149,21 +162,20 @@ def read_map(path: str | PathLike[str]) -> list[Line]:
         If ``path`` does not exist.
     MapFormatError
         If the file is not JSON (naming the text line), has no ``"lines"`` list, or a line
-        object lacks a key or holds a non-number, a non-finite number, a negative ``rho``
-        or a non-integer ``n``, or a coordinate or ``rho`` beyond :data:`MAX_COORDINATE`
-        (naming the index, ``lines[i]``). A ``theta`` outside
+        object lacks a key or holds a non-number, ``NaN``, ``Infinity`` or a number beyond
+        the largest float (naming the text line too, :func:`fhslam.io.jsontext.parse_json`),
+        a negative ``rho``, an ``n`` that is no whole number from 0 to :data:`MAX_POINTS`, or
+        a coordinate or ``rho`` beyond :data:`MAX_COORDINATE` (naming the index,
+        ``lines[i]``). A ``theta`` outside
         [0, 2 pi) is wrapped into it.
     """
     path = input_path(path, "map")
     try:
-        # json accepts NaN/Infinity; reject them as non-finite numbers below.
         with reading(path):
             text = path.read_text(encoding="utf-8")
-        data = json.loads(text)
-    except json.JSONDecodeError as e:
-        raise MapFormatError(f"{path}:{e.lineno}: not valid JSON ({e.msg})") from None
     except UnicodeDecodeError as e:
         raise MapFormatError(f"{path}: not a text file ({e.reason})") from None
+    data = parse_json(text, path, MapFormatError)
     if not isinstance(data, dict) or "lines" not in data:
         raise MapFormatError(f'{path}: expected a JSON object {{"lines": [...]}}')
     if not isinstance(data["lines"], list):

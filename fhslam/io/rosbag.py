@@ -30,6 +30,13 @@ its squared norm within 0.01 of 1; an all-zero quaternion is no rotation). Ignor
 field would only hide a corrupt bag. Readings of +inf, -inf and NaN are REP 117's codes
 (no return, too close, invalid): no returns, without a warning.
 
+Damaged data is a :class:`BagFormatError` too, and nothing is skipped: a bag that cannot be
+opened names where its records first break (``its records break at byte N (record k, after
+c chunks): ...``); a message that cannot be read names the message, its topic and, in a ROS 1
+bag, its chunk and the chunk's bytes in the file (a chunk that does not decompress, a record
+header or a message that does not parse). A compressed bag loses a damaged chunk's messages
+together, hundreds of scans: a bag read with such a hole would pass for a whole one.
+
 An interlaced laser, whose scans share the increment but start up to one beam apart (the
 Freiburg hospital log: four layouts a quarter degree apart, 181 or 180 beams), is read with
 the first layout's bearings and a per-scan ``Log.angle_offsets``; other mixed layouts are
@@ -38,9 +45,13 @@ refused. ``beams="bag"`` always takes the bag's values.
 
 from __future__ import annotations
 
+import heapq
+import itertools
 import warnings
+from collections.abc import Iterator
 from os import PathLike
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -103,7 +114,8 @@ def _pose_problem(position, q) -> str | None:
     quat = np.array([q.x, q.y, q.z, q.w], dtype=float)
     if not np.all(np.isfinite(quat)):
         return f"non-finite orientation quaternion {quat.tolist()}"
-    norm2 = float(quat @ quat)
+    with np.errstate(over="ignore"):  # a damaged quaternion: its norm is inf
+        norm2 = float(quat @ quat)
     if abs(norm2 - 1.0) > QUATERNION_TOLERANCE:
         return (
             f"orientation quaternion {quat.tolist()} is not a rotation: its squared norm "
@@ -188,7 +200,9 @@ def read_bag(
         repeat or leap forward more than a day; odometry jumps; negative readings or
         readings beyond 1000 m (read as no return; NaN and ±inf are ROS's own codes,
         REP 117, read as no return without a warning); scans without a return; more than
-        10,000 beams (:func:`fhslam.io.log.check_readings`).
+        10,000 beams (:func:`fhslam.io.log.check_readings`). Without ``max_range``: a
+        ``range_max`` or no-return code well below readings the bag repeats, which are then
+        read as no return (:func:`fhslam.io.log.effective_max_range`).
     """
     from rosbags.highlevel import AnyReader
     from rosbags.typesys import Stores, get_typestore
@@ -203,14 +217,15 @@ def read_bag(
         reader = AnyReader([p], default_typestore=get_typestore(Stores.ROS1_NOETIC))
         reader.open()
     except Exception as e:  # rosbags raises its own error types for unreadable files
-        raise BagFormatError(f"{p}: not a readable ROS bag ({e})") from e
+        raise BagFormatError(
+            f"{p}: not a readable ROS bag ({_reason(e)}){_record_damage(p)}"
+        ) from e
     try:
         scan_conns = _pick(reader, SCAN_TYPE, scan_topic, "laser scan", p)
         odom_conns = _pick(reader, ODOM_TYPE, odom_topic, "odometry", p)
         stamps, ranges, layout, max_range, starts = [], [], set(), 0.0, []
         widest = (0, 0)  # beams, scan index
-        for k, (conn, _t, raw) in enumerate(reader.messages(connections=scan_conns)):
-            m = reader.deserialize(raw, conn.msgtype)
+        for k, conn, m in _messages(reader, scan_conns, "scan", p):
             problem = _scan_problem(m)
             if problem is not None:
                 raise BagFormatError(f"{p}: scan {k} of topic {conn.topic!r}: {problem}")
@@ -232,8 +247,7 @@ def read_bag(
         if len(layout) > 1 and not interlaced:
             raise BagFormatError(f"{p}: scans with different angle layouts {sorted(layout)}")
         odo_t, odo = [], []
-        for k, (conn, _t, raw) in enumerate(reader.messages(connections=odom_conns)):
-            m = reader.deserialize(raw, conn.msgtype)
+        for k, conn, m in _messages(reader, odom_conns, "odometry message", p):
             odo_t.append(m.header.stamp.sec + 1e-9 * m.header.stamp.nanosec)
             pose = m.pose.pose
             problem = _pose_problem(pose.position, pose.orientation)
@@ -256,22 +270,23 @@ def read_bag(
     angles = flaser_angles(n) if beams == "carmen" and converted else a0 + inc * np.arange(n)
     stated = max_range
     if max_range_override is None:
-        max_range, _ = effective_max_range(rr, stated, stated)
+        in_time = rr[np.argsort(stamps, kind="stable")]  # repeated scans are found in order
+        max_range, _ = effective_max_range(in_time, stated, stated, p, BagWarning)
     else:
         max_range = float(max_range_override)
     t = np.asarray(stamps)
+    order = np.argsort(t, kind="stable")
+    odometry = _interpolate_poses(np.asarray(odo_t), np.asarray(odo), t[order], p)  # may refuse
     back = np.diff(t) < 0
     if back.any():
         k = int(np.flatnonzero(back)[0])
         warnings.warn(
             f"{p}: the header stamp goes back in time at {plural(int(back.sum()), 'scan')} of "
-            f"the bag (first: scan {k + 1}, {t[k + 1]!r} after {t[k]!r}); the scans are sorted "
-            "by stamp",
+            f"the bag (first: scan {k + 1}, {float(t[k + 1])!r} after {float(t[k])!r}); the "
+            "scans are sorted by stamp",
             BagWarning,
             stacklevel=2,
         )
-    order = np.argsort(t, kind="stable")
-    odometry = _interpolate_poses(np.asarray(odo_t), np.asarray(odo), t[order], p)
     check_sequence(p, t[order], odometry, None, BagWarning)
     check_readings(p, rr[order], max_range, None, BagWarning, non_finite=False)
     return Log(
@@ -293,8 +308,8 @@ def _laser_offset(reader, path: Path) -> NDArray[np.float64]:
     for conn in reader.connections:
         if conn.msgtype != "tf2_msgs/msg/TFMessage" or "static" not in conn.topic:
             continue
-        for k, (c, _t, raw) in enumerate(reader.messages(connections=[conn])):
-            for tr in reader.deserialize(raw, c.msgtype).transforms:
+        for k, _c, m in _messages(reader, [conn], "message", path):
+            for tr in m.transforms:
                 if "laser" in tr.child_frame_id:
                     v, q = tr.transform.translation, tr.transform.rotation
                     problem = _pose_problem(v, q)
@@ -305,6 +320,139 @@ def _laser_offset(reader, path: Path) -> NDArray[np.float64]:
                         )
                     return np.array([v.x, v.y, _yaw(q)])
     return np.zeros(3)
+
+
+def _messages(reader, conns, what: str, path: Path) -> Iterator[tuple[int, Any, Any]]:
+    """``(k, connection, message)`` for the messages of ``conns`` (one topic) in the bag's
+    order, ``k`` counting from 0, each deserialized. Data that cannot be read (a chunk that
+    does not decompress, a record header or a message that does not parse) is a
+    :class:`BagFormatError` naming the message, and in a ROS 1 bag the chunk and its bytes in
+    the file: the messages of a damaged chunk are lost together (hundreds of scans in a
+    compressed bag), so the bag is refused rather than read with a hole."""
+    topic = conns[0].topic
+    messages = reader.messages(connections=conns)
+    k = 0
+    while True:
+        try:
+            conn, _t, raw = next(messages)
+        except StopIteration:
+            return
+        except Exception as e:  # rosbags and its decompressors raise many types
+            raise BagFormatError(
+                f"{path}: {what} {k} of topic {topic!r}: damaged data{_chunk_of(reader, conns, k)}"
+                f", the bag cannot be read past it ({_reason(e)})"
+            ) from e
+        try:
+            m = reader.deserialize(raw, conn.msgtype)
+        except Exception as e:  # as above: the message's bytes are damaged
+            raise BagFormatError(
+                f"{path}: {what} {k} of topic {topic!r}: damaged data"
+                f"{_chunk_of(reader, conns, k)}, not a {conn.msgtype} ({_reason(e)})"
+            ) from e
+        yield k, conn, m
+        k += 1
+
+
+def _reason(e: BaseException) -> str:
+    """An exception as a few words: its type and its message, on one line."""
+    text = " ".join(str(e).split())
+    return f"{type(e).__name__}: {text}" if text else type(e).__name__
+
+
+def _chunk_of(reader, conns, k: int) -> str:
+    """Where in a ROS 1 bag the ``k``-th message of ``conns`` lies: ``" in chunk 4 of 17
+    (bytes 344123-398000 of the file)"``; ``""`` where that is not known (a ROS 2 bag)."""
+    try:
+        (bag,) = reader.readers
+        entries = heapq.merge(*(bag.indexes[c.id] for c in conns))
+        entry = next(itertools.islice(entries, k, None))
+        starts = sorted(bag.chunks)
+        chunk = bag.chunks[entry.chunk_pos]
+        return (
+            f" in chunk {starts.index(entry.chunk_pos) + 1} of {len(starts)} (bytes "
+            f"{chunk.datapos}-{chunk.datapos + chunk.datasize} of the file)"
+        )
+    except Exception:  # only a detail of the message: left out if unknown
+        return ""
+
+
+ROS1_OPS = {2: "a message data", 3: "the bag header", 4: "an index data", 5: "a chunk",
+            6: "a chunk info", 7: "a connection"}  # fmt: skip
+"""The record types of a ROS 1 bag (its ``op`` header field)."""
+
+MAX_RECORD_HEADER = 1 << 20
+"""Longest record header taken for one, bytes (a ROS 1 bag's are tens to hundreds)."""
+
+
+def _record_damage(path: Path) -> str:
+    """Where the records of a ROS 1 bag first break, for the message of a bag that cannot be
+    opened: ``"; its records break at byte 688663 (record 34, after 8 chunks): ..."``, or
+    ``""`` where they do not (or the file is no ROS 1 bag). A record is a header (its length,
+    then ``name=value`` fields, ``op`` among them) and data (its length, then the bytes)."""
+    try:
+        size = path.stat().st_size
+        with open(path, "rb") as f:
+            if f.read(13) != b"#ROSBAG V2.0\n":
+                return ""
+            pos, k, chunks = 13, 0, 0
+            while pos < size:
+                op, n, m, why = _record_at(f, pos, size)
+                if why is not None:
+                    where = f"byte {pos} (record {k}, after {chunks} chunks)"
+                    return f"; its records break at {where}: {why}"
+                chunks += op == 5
+                pos += 8 + n + m
+                f.seek(pos)
+                k += 1
+    except OSError:
+        return ""
+    return ""
+
+
+def _record_at(f, pos: int, size: int) -> tuple[int, int, int, str | None]:
+    """The record at ``pos`` of an open bag of ``size`` bytes: its ``op``, the lengths of its
+    header and its data, and why it is damaged (``None``: it is not)."""
+    head = f.read(4)
+    if len(head) < 4:
+        return 0, 0, 0, "the file ends inside a record's header length"
+    n = int.from_bytes(head, "little")
+    if n > min(size - pos - 4, MAX_RECORD_HEADER):
+        return 0, n, 0, f"a record header of {n} bytes, in a file of {size}"
+    op, why = _record_op(f.read(n))
+    if why is not None:
+        return op, n, 0, why
+    data = f.read(4)
+    if len(data) < 4:
+        return op, n, 0, f"the file ends inside the data length of {ROS1_OPS[op]} record"
+    m = int.from_bytes(data, "little")
+    if pos + 8 + n + m > size:
+        return (
+            op,
+            n,
+            m,
+            (
+                f"{ROS1_OPS[op]} record of {m} bytes of data runs past the end of the file "
+                f"({size} bytes; cut short?)"
+            ),
+        )
+    return op, n, m, None
+
+
+def _record_op(header: bytes) -> tuple[int, str | None]:
+    """A record header's ``op`` code, and why the header is damaged (``None``: it is not)."""
+    fields, i = {}, 0
+    while i < len(header):
+        n = int.from_bytes(header[i : i + 4], "little")
+        field = header[i + 4 : i + 4 + n]
+        if i + 4 + n > len(header) or b"=" not in field:
+            return 0, f"a damaged field in a record header at byte {i} of its {len(header)}"
+        name, _, value = field.partition(b"=")
+        fields[name] = value
+        i += 4 + n
+    op = fields.get(b"op", b"")
+    if len(op) != 1 or op[0] not in ROS1_OPS:
+        return 0, f"a record header without a known record type (op {op!r})"
+    return op[0], None
 
 
 def _interpolate_poses(t_src, poses, t_query, path) -> NDArray[np.float64]:

@@ -37,6 +37,7 @@ from numpy.typing import ArrayLike, NDArray
 from fhslam.errors import InputError, InputWarning
 from fhslam.geometry import compose, segment_distances, transform_points, wrap_angle
 from fhslam.io.files import input_path, reading
+from fhslam.io.jsontext import parse_json
 from fhslam.io.mapfile import MAX_COORDINATE
 
 BUILTIN_WORLDS = ("paper", "hall", "corridor", "ring", "offices", "campus", "random:SEED")
@@ -709,12 +710,7 @@ def load_world(name_or_path: str | PathLike[str]) -> World:
     try:
         with reading(path):
             text = path.read_text(encoding="utf-8")
-        data = json.loads(text)
-    except (json.JSONDecodeError, UnicodeDecodeError) as e:
+    except UnicodeDecodeError as e:
         raise WorldFormatError(f"{path}: not valid JSON ({e})") from None
-    except RecursionError:
-        raise WorldFormatError(
-            f"{path}: not a world: its JSON is nested too deeply to read (a world is an object "
-            "of lists of numbers, nested three deep)"
-        ) from None
+    data = parse_json(text, path, WorldFormatError)  # NaN / Infinity: refused as not finite
     return World.from_dict(data, source=str(path))

@@ -21,11 +21,13 @@ from __future__ import annotations
 
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
+from typing import ClassVar
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from fhslam.calibration import calibrate_pose
+from fhslam.errors import ParameterError, Range, check_ranges
 from fhslam.extraction import ExtractionParams, extract_lines
 from fhslam.geometry import as_pose, compose, relative
 from fhslam.lines import Line, transform_lines
@@ -87,6 +89,28 @@ class SlamParams:
     robust_scale: float | None = 0.02
     max_merge_residual: float = 0.05
     extractor: Callable[[NDArray[np.float64]], list[Line]] | None = None
+
+    RANGES: ClassVar[dict[str, Range]] = {
+        "min_reference_length": Range(0.0, 1000.0, unit="m"),
+        "min_reference_points": Range(0, 1_000_000, integer=True),
+        "iterations": Range(1, 100, integer=True),
+        "min_eigen_ratio": Range(0.0, 1.0, cap=False),
+        "max_correction": Range(0.0, 100.0, unit="m"),
+        "max_rotation_deg": Range(0.0, 180.0, cap=False, unit="degrees"),
+        "robust_scale": Range(0.0, 10.0, open_low=True, optional=True, unit="m"),
+        "max_merge_residual": Range(0.0, 10.0, unit="m"),
+    }
+    """The range of each number (:class:`fhslam.errors.Range`), checked when the parameters
+    are made (``extraction`` and ``matching`` check their own); "at most": a limit of
+    plausibility."""
+
+    def __post_init__(self) -> None:
+        for name, kind in (("extraction", ExtractionParams), ("matching", MatchParams)):
+            if not isinstance(getattr(self, name), kind):
+                raise ParameterError("SlamParams", name, getattr(self, name), f"a {kind.__name__}")
+        if not (self.extractor is None or callable(self.extractor)):
+            raise ParameterError("SlamParams", "extractor", self.extractor, "callable or None")
+        check_ranges(self, self.RANGES)
 
 
 class FastHoughSLAM:

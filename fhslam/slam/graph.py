@@ -70,11 +70,12 @@ import threading
 import weakref
 from collections import OrderedDict
 from dataclasses import dataclass, field
-from typing import NamedTuple
+from typing import ClassVar, NamedTuple
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from fhslam.errors import ParameterError, Range, check_ranges
 from fhslam.extraction import extract_lines
 from fhslam.geometry import as_pose, compose, inverse, relative, transform_points
 from fhslam.lines import Line, transform_lines
@@ -460,71 +461,67 @@ class GraphSlamParams:
     optimize_iterations: int = 10
     optimize_tol: float = 1e-4
 
+    RANGES: ClassVar[dict[str, Range]] = {
+        "keyframe_distance": Range(0.0, 100.0, open_low=True, unit="m"),
+        "keyframe_angle_deg": Range(0.0, 360.0, open_low=True, cap=False, unit="degrees"),
+        "cloud_max_range": Range(0.0, 1000.0, open_low=True, unit="m"),
+        "cloud_voxel": Range(0.0, 1.0, open_low=True, unit="m"),
+        "corner_deg": Range(0.0, 90.0, cap=False, unit="degrees"),
+        "submap_keyframes": Range(1, 1000, integer=True),
+        "max_doubtful": Range(0, 1_000_000, integer=True),
+        "edge_sigma": Range(0.0, 10.0, open_low=True, unit="m"),
+        "edge_points": Range(0.0, 1e6, open_low=True),
+        "odometry_sigma": Range(0.0, 1000.0, open_low=True, items=2),
+        "loop_radius": Range(0.0, 1000.0, unit="m"),
+        "loop_growth": Range(0.0, 10.0, open_low=True),
+        "loop_max_radius": Range(0.0, 1000.0, unit="m"),
+        "loop_min_gap": Range(1, 1_000_000, integer=True),
+        "loop_target_keyframes": Range(0, 1000, integer=True),
+        "loop_candidates": Range(0, 1000, integer=True),
+        "loop_window": Range(0.0, 100.0, unit="m"),
+        "loop_max_window": Range(0.0, 100.0, unit="m"),
+        "loop_window_deg": Range(0.0, 180.0, cap=False, unit="degrees"),
+        "loop_min_score": Range(0.0, 1.0, cap=False),
+        "loop_min_pairs": Range(0, 1_000_000, integer=True),
+        "loop_max_rms": Range(0.0, 10.0, unit="m"),
+        "loop_kernel": Range(0.0, 1000.0, open_low=True),
+        "loop_max_chi2": Range(0.0, 1e9),
+        "loop_optimize_chi2": Range(0.0, 1e9),
+        "loop_confirm_distance": Range(0.0, 100.0, open_low=True, unit="m"),
+        "loop_confirm_deg": Range(0.0, 180.0, open_low=True, unit="degrees"),
+        "loop_unique_radius": Range(0.0, 100.0, unit="m"),
+        "loop_consistency": Range(0.0, 100.0, open_low=True, unit="m"),
+        "loop_consistency_deg": Range(0.0, 180.0, open_low=True, unit="degrees"),
+        "loop_confirm_window": Range(1, 1_000_000, integer=True),
+        "loop_repeat_confirm": Range(0.0, 100.0, unit="m"),
+        "global_every": Range(0, 1_000_000, integer=True),
+        "global_after": Range(0.0, 1e6, unit="m"),
+        "global_keyframes": Range(1, 1000, integer=True),
+        "global_min_score": Range(0.0, 1.0, cap=False),
+        "global_window_deg": Range(0.0, 180.0, open_low=True, cap=False, unit="degrees"),
+        "global_max_window": Range(0.0, 500.0, open_low=True, unit="m"),
+        "global_max_ambiguity": Range(0.0, 1.0, open_low=True, cap=False),
+        "global_confirm_score": Range(0.0, 1.0, cap=False),
+        "global_lookback": Range(0.0, 1000.0),
+        "global_consistency": Range(0.0, 100.0, open_low=True, unit="m"),
+        "global_consistency_deg": Range(0.0, 180.0, open_low=True, unit="degrees"),
+        "optimize_iterations": Range(1, 1000, integer=True),
+        "optimize_tol": Range(0.0, 1.0),
+    }
+    """The range of each number (:class:`fhslam.errors.Range`), checked when the parameters
+    are made (``tracker`` and ``lines`` check their own). Upper bounds given as "at most"
+    are limits of plausibility (a window or radius beyond them outgrows any map, a count
+    any run), the others are limits of meaning (scores and shares from 0 to 1, angles)."""
+
     def __post_init__(self) -> None:
-        for name in (
-            "keyframe_distance",
-            "keyframe_angle_deg",
-            "cloud_max_range",
-            "cloud_voxel",
-            "edge_sigma",
-            "edge_points",
-            "loop_confirm_distance",
-            "loop_confirm_deg",
-            "loop_consistency",
-            "loop_consistency_deg",
-            "global_consistency",
-            "global_consistency_deg",
-        ):
-            if not getattr(self, name) > 0:
-                raise ValueError(f"{name} must be > 0, got {getattr(self, name)}")
-        if (
-            self.submap_keyframes < 1
-            or self.loop_candidates < 0
-            or self.loop_min_gap < 1
-            or self.loop_target_keyframes < 0
-        ):
-            raise ValueError(
-                "submap_keyframes and loop_min_gap must be >= 1, loop_candidates and "
-                "loop_target_keyframes >= 0"
-            )
-        if not 0 <= self.corner_deg <= 90:
-            raise ValueError(f"corner_deg must be in [0, 90] degrees, got {self.corner_deg}")
+        for name, kind in (("tracker", TrackerParams), ("lines", SlamParams)):
+            if not isinstance(getattr(self, name), kind):
+                raise ParameterError(
+                    "GraphSlamParams", name, getattr(self, name), f"a {kind.__name__}"
+                )
+        check_ranges(self, self.RANGES)
         if self.pair_share and not self.pair_edges:
             raise ValueError("pair_share shares the pair edges' information: set pair_edges too")
-        if not self.global_after >= 0:
-            raise ValueError(f"global_after must be >= 0, got {self.global_after}")
-        if self.global_every < 0 or self.global_keyframes < 1:
-            raise ValueError(
-                "global_every must be >= 0 and global_keyframes >= 1, got "
-                f"{self.global_every} and {self.global_keyframes}"
-            )
-        if not (0 <= self.global_min_score <= 1 and self.global_max_window > 0):
-            raise ValueError(
-                "global_min_score must be in [0, 1] and global_max_window > 0, got "
-                f"{self.global_min_score} and {self.global_max_window}"
-            )
-        if not 0 <= self.global_confirm_score <= 1:
-            raise ValueError(
-                f"global_confirm_score must be in [0, 1], got {self.global_confirm_score}"
-            )
-        if not self.global_lookback >= 0:
-            raise ValueError(f"global_lookback must be >= 0, got {self.global_lookback}")
-        if not 0 < self.global_max_ambiguity <= 1:
-            raise ValueError(
-                f"global_max_ambiguity must be in (0, 1], got {self.global_max_ambiguity}"
-            )
-        if not 0 < self.global_window_deg <= 180:
-            raise ValueError(f"global_window_deg must be in (0, 180], got {self.global_window_deg}")
-        if not self.loop_unique_radius >= 0:
-            raise ValueError(f"loop_unique_radius must be >= 0, got {self.loop_unique_radius}")
-        if not self.loop_repeat_confirm >= 0:
-            raise ValueError(f"loop_repeat_confirm must be >= 0, got {self.loop_repeat_confirm}")
-        if self.loop_confirm_window < 1:
-            raise ValueError(f"loop_confirm_window must be >= 1, got {self.loop_confirm_window}")
-        if not self.loop_optimize_chi2 >= 0:
-            raise ValueError(f"loop_optimize_chi2 must be >= 0, got {self.loop_optimize_chi2}")
-        if not 0 <= self.loop_min_score <= 1:
-            raise ValueError(f"loop_min_score must be in [0, 1], got {self.loop_min_score}")
 
 
 @dataclass(frozen=True, eq=False)

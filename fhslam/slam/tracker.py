@@ -31,10 +31,12 @@ scan.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import ClassVar
 
 import numpy as np
 from numpy.typing import NDArray
 
+from fhslam.errors import Range, check_ranges
 from fhslam.geometry import as_pose, transform_points
 from fhslam.scanmatch import (
     LikelihoodGrid,
@@ -123,22 +125,35 @@ class TrackerParams:
     prior_sigma: tuple[float, float] = (0.05, 10.0)
     residual_sigma: float = 0.03
 
+    RANGES: ClassVar[dict[str, Range]] = {
+        "resolution": Range(0.01, 1.0, unit="m"),
+        "sigma": Range(0.001, 5.0, unit="m"),
+        "angle_step_deg": Range(0.05, 45.0, unit="degrees"),
+        "window": Range(0.0, 10.0, unit="m"),
+        "window_deg": Range(0.0, 180.0, cap=False, unit="degrees"),
+        "turn_fraction": Range(0.0, 10.0),
+        "search_prior": Range(0.0, 1000.0, items=2),
+        "recovery_window": Range(0.0, 20.0, unit="m"),
+        "recovery_window_deg": Range(0.0, 180.0, cap=False, unit="degrees"),
+        "max_step": Range(0.0, 100.0, unit="m"),
+        "max_turn_deg": Range(0.0, 360.0, cap=False, unit="degrees"),
+        "min_score": Range(0.0, 1.0, cap=False),
+        "sure_score": Range(0.0, 1.0, cap=False),
+        "query_voxel": Range(0.001, 1.0, unit="m"),
+        "max_points": Range(1, 100_000, integer=True),
+        "refine_distance": Range(0.0, 10.0, open_low=True, unit="m"),
+        "refine_iterations": Range(1, 100, integer=True),
+        "prior_sigma": Range(0.0, 1000.0, open_low=True, items=2),
+        "residual_sigma": Range(0.0, 1.0, open_low=True, unit="m"),
+    }
+    """The range of each number (:class:`fhslam.errors.Range`), checked when the parameters
+    are made. The upper bounds of lengths, angle steps and counts are limits of
+    plausibility: past them a search's grid or loop outgrows any machine. The lower bounds
+    of ``resolution``, ``sigma``, ``angle_step_deg`` and ``query_voxel`` likewise (a grid
+    finer than 1 cm over a local map of 50 m holds more than 25 million cells)."""
+
     def __post_init__(self) -> None:
-        for name in ("resolution", "sigma", "angle_step_deg", "query_voxel", "refine_distance"):
-            if not getattr(self, name) > 0:
-                raise ValueError(f"TrackerParams.{name} must be > 0, got {getattr(self, name)}")
-        if not (len(self.prior_sigma) == 2 and all(v > 0 for v in self.prior_sigma)):
-            raise ValueError(
-                f"TrackerParams.prior_sigma must be two values > 0, got {self.prior_sigma}"
-            )
-        if self.refine_iterations < 1:
-            raise ValueError(
-                f"TrackerParams.refine_iterations must be >= 1, got {self.refine_iterations}"
-            )
-        if not self.residual_sigma > 0:
-            raise ValueError(f"TrackerParams.residual_sigma must be > 0, got {self.residual_sigma}")
-        if not 0 <= self.min_score <= 1:
-            raise ValueError(f"TrackerParams.min_score must be in [0, 1], got {self.min_score}")
+        check_ranges(self, self.RANGES)
 
 
 @dataclass(frozen=True)

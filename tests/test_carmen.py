@@ -762,8 +762,9 @@ def test_a_robotlaser1_header_no_laser_states_is_an_error(tmp_path, fields, mess
 def test_a_reading_repeated_far_below_the_stated_range_is_no_code(tmp_path):
     """Issue 13: a ROBOTLASER1 log stating 20 m whose scans repeat exactly took the 2.0 m
     ahead for the no-return code and dropped every reading from 2 m on. A code is sought in
-    the upper half of the stated range only; a FLASER log, stating none, keeps the rule of
-    the readings' own scale."""
+    the upper half of the stated range only; and the readings alone give none either: the
+    scans repeat (a robot standing still), so they count as one scan, in which no value is
+    read often enough."""
     rows = [[2.5, 2.2, 2.0, 2.2, 2.5]] * 30
     path = tmp_path / "rl.clf"
     path.write_text(
@@ -774,8 +775,10 @@ def test_a_reading_repeated_far_below_the_stated_range_is_no_code(tmp_path):
         log = read_carmen(path)
     assert log.max_range == 20.0 and log.stated_max_range == 20.0
     assert len(log.scan(0).points()[0]) == 5
-    assert no_return_reading(log.ranges) == 2.0 and no_return_reading(log.ranges, stated=20) is None
-    coded = [[2.5, 2.2, 19.5, 2.2, 19.5]] * 30  # a code near the stated range: still found
+    assert no_return_reading(log.ranges) is None
+    assert no_return_reading(log.ranges, stated=20) is None
+    # a code near the stated range, in scans of a robot on the move: still found
+    coded = [[2.5 + 0.1 * k, 2.2, 19.5, 2.2 + 0.1 * k, 19.5] for k in range(30)]
     path.write_text(
         "".join(robotlaser1(r, None, [0.1 * k, 0, 0], float(k)) + "\n" for k, r in enumerate(coded))
     )

@@ -253,7 +253,9 @@ def test_a_reading_repeated_far_below_range_max_is_no_no_return_code(tmp_path):
         warnings.simplefilter("error")  # no "no scan has a return" any more
         log = read_bag(path)
     assert log.max_range == 80.0 and log.stated_max_range == 80.0
-    assert no_return_reading(log.ranges) == 2.0  # what the readings alone suggest
+    # what the readings alone suggest: 3.0 m, the one value of every beam beyond ±1 rad,
+    # with nothing above it (the scans repeat: they count as one)
+    assert no_return_reading(log.ranges) == 3.0
     assert no_return_reading(log.ranges, stated=80.0) is None
     assert len(log.scan(0).points()[0]) == 181  # every beam a point
 

@@ -4,7 +4,9 @@ The files are not part of the package (nobody on the team wrote them; see
 ``shared/data/SOURCES.md``). :func:`find_dataset` looks for a dataset's file, in this order:
 
 1. an explicit path to an existing file;
-2. the folder named by the environment variable ``$FHSLAM_DATA``;
+2. the folder named by the environment variable ``$FHSLAM_DATA`` (set, it must name a
+   folder: a file or a path where nothing exists is an error, so that a mistyped path is
+   not passed over for a copy elsewhere);
 3. a ``shared/data`` folder beside the repository: ``<ancestor>/../shared/data`` for the
    current working directory and each of its ancestors, then beside this source tree (an
    editable install);
@@ -281,9 +283,11 @@ def find_dataset(
 
     Raises :class:`DatasetNotFoundError` (a :class:`~fhslam.errors.MissingInputError`) listing
     every place looked at, or naming the URL and the cause when a download fails (a network
-    error, or a downloaded file whose sha256 is not the recorded one);
+    error, or a downloaded file whose sha256 is not the recorded one), or naming
+    ``$FHSLAM_DATA`` when it is set to a path where nothing exists;
     :class:`~fhslam.errors.InputError` for an unknown name, for a
-    dataset without a file of ``kind`` (mit-killian has no log) and for a local copy whose
+    dataset without a file of ``kind`` (mit-killian has no log), for a ``$FHSLAM_DATA`` that
+    names a file (``"FHSLAM_DATA=<path>: is not a folder ..."``) and for a local copy whose
     size is not the recorded one, ``ValueError`` for an unknown kind.
     """
     if kind not in KINDS:
@@ -301,6 +305,7 @@ def find_dataset(
     else:
         raise InputError(f"unknown dataset {text!r}; known datasets: {_known()}")
     f = ds.file(kind)
+    _check_env_folder(f.name)
 
     looked: list[str] = []
     if os.environ.get(ENV_VAR) is None:
@@ -336,6 +341,29 @@ def find_dataset(
         f"(`--download` on the command line) to fetch it from {f.url} "
         "(checked against its sha256) into the user cache."
     )
+
+
+def _check_env_folder(name: str) -> None:
+    """Refuse a ``$FHSLAM_DATA`` that is set (not empty) but names no folder: a file, or
+    nothing at all (a typo would otherwise go unnoticed, and a copy elsewhere be used).
+
+    Raises
+    ------
+    InputError
+        ``"FHSLAM_DATA=<path>: is not a folder ..."``; a :class:`DatasetNotFoundError`
+        ``"FHSLAM_DATA=<path>: no such folder ..."`` if nothing exists there.
+    """
+    env = os.environ.get(ENV_VAR)
+    if not env:
+        return
+    d = Path(env).expanduser()
+    fix = f"set {ENV_VAR} to the folder holding {name}, or unset it"
+    if not d.exists():
+        raise DatasetNotFoundError(
+            f"{ENV_VAR}={env}: no such folder (looked for {d / name}); {fix}", str(d / name)
+        )
+    if not d.is_dir():
+        raise InputError(f"{ENV_VAR}={env}: is not a folder (looking for {name}); {fix}")
 
 
 def _check_size(path: Path, f: DataFile) -> None:

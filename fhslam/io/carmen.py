@@ -5,6 +5,16 @@ Read: ``FLASER`` (old format) and ``ROBOTLASER1`` laser messages become the scan
 layout (below); ``#`` comments, blank lines and every other message (``ODOM``, ``SYNC``,
 ``TRUEPOS``, ...) are skipped, since the laser messages carry the odometry pose themselves.
 
+The file is read as a stream of UTF-8 text lines (``\\n``, ``\\r\\n`` or ``\\r`` ending a
+line), in pieces of at most :data:`MAX_LINE` characters, so that memory follows the scans
+kept, not the size of the file; a byte-order mark at its start is skipped. A line that is
+not text -- holding NUL bytes or bytes that are not UTF-8, or longer than :data:`MAX_LINE`
+(a stretch of binary data; the NUL bytes a crash leaves at the end of a file) -- is skipped,
+and the lines after it are read: one :class:`CarmenWarning` names the file, the line and
+byte where the first such line starts, how many bytes were skipped and up to where. A file
+without a laser message that has such lines is not a CARMEN text log (a
+:class:`CarmenFormatError`, which says so for a gzip-compressed file: decompress it first).
+
 Write: one ``ODOM`` and one ``FLASER`` line per scan, every number as Python's shortest
 round-trip ``repr``, so reading the file back gives exactly the same floats. The odometry
 triple of a written laser line is the *odometry*, its laser-pose triple the odometry ⊕
@@ -84,10 +94,14 @@ is a :class:`CarmenFormatError`; every other ``PARAM`` (many hold strings) is ig
 
 from __future__ import annotations
 
+import codecs
+import io
 import math
 import warnings
-from dataclasses import dataclass
+from collections.abc import Iterator
+from dataclasses import dataclass, field
 from os import PathLike
+from pathlib import Path
 
 import numpy as np
 from numpy.typing import NDArray
@@ -540,6 +554,89 @@ def _flaser_layout(path, params: dict[str, _Param], n: int, first: int) -> NDArr
 
 _PARSERS = {"FLASER": _parse_flaser, "ROBOTLASER1": _parse_robotlaser1}
 
+MAX_LINE = 1 << 20
+"""The longest line read, in characters (1 MiB of text; a laser line of 100,000 beams is
+about 400 kB). A longer stretch without a line break is not a CARMEN line: it is skipped as
+unreadable, read in pieces of this size, so that no more of it is ever held in memory."""
+
+
+@dataclass
+class _Unreadable:
+    """The lines of a file that are not text (see :func:`_text_lines`), for one warning."""
+
+    lines: int = 0
+    nbytes: int = 0
+    first_line: int = 0
+    start: int = 0  # byte offset of the first unreadable line
+    last_line: int = 0
+    end: int = 0  # byte offset just past the last one
+    reasons: set[str] = field(default_factory=set)
+    size: int = 0  # bytes read in all
+    gzip: bool = False  # the file starts with gzip's magic bytes
+
+    def add(self, lineno: int, start: int, end: int, reason: str) -> None:
+        if self.last_line != lineno:
+            self.lines += 1
+        if not self.first_line:
+            self.first_line, self.start = lineno, start
+        self.last_line, self.end = lineno, end
+        self.nbytes += end - start
+        self.reasons.add(reason)
+
+    def describe(self) -> str:
+        """``"N bytes that are not text (why) from byte X (line A) to ..."``."""
+        why = ", ".join(sorted(self.reasons))
+        end = "the end of the file" if self.end == self.size else f"byte {self.end}"
+        if self.lines == 1:
+            where = f"from byte {self.start} (line {self.first_line}) to {end}"
+        else:
+            where = (
+                f"in {self.lines} lines from byte {self.start} (line {self.first_line}) to "
+                f"{end} (line {self.last_line})"
+            )
+        return f"{self.nbytes} bytes that are not text ({why}) {where}"
+
+
+def _text_lines(path: Path, junk: _Unreadable) -> Iterator[tuple[int, str]]:
+    """The lines of the file ``path`` that are text, as ``(line number, line)``: decoded as
+    UTF-8, a byte-order mark at the start skipped, any line break (``\\n``, ``\\r\\n``,
+    ``\\r``) ending a line, as a text file is read. A line holding NUL bytes or bytes that are
+    not UTF-8, or longer than :data:`MAX_LINE`, is not yielded but recorded in ``junk``. The
+    file is read in pieces of at most :data:`MAX_LINE` characters."""
+    with path.open("rb") as f:
+        head = f.read(3)
+        junk.gzip = head[:2] == b"\x1f\x8b"
+        offset = 3 if head == codecs.BOM_UTF8 else 0
+        f.seek(offset)
+        text = io.TextIOWrapper(f, encoding="utf-8", errors="surrogateescape", newline="")
+        with text:
+            readline = text.readline
+            lineno = 0
+            long_line = False  # the last piece was cut at MAX_LINE: this one continues it
+            while piece := readline(MAX_LINE):
+                start = offset
+                if piece.isascii():
+                    offset += len(piece)
+                    reason = "NUL bytes" if "\x00" in piece else None
+                else:
+                    try:
+                        offset += len(piece.encode("utf-8"))
+                        reason = "NUL bytes" if "\x00" in piece else None
+                    except UnicodeEncodeError:  # a byte that is not UTF-8, as a surrogate
+                        offset += len(piece.encode("utf-8", "surrogateescape"))
+                        reason = "bytes that are not UTF-8"
+                if not long_line:
+                    lineno += 1
+                cut = len(piece) == MAX_LINE and piece[-1] not in "\r\n"
+                if long_line or cut:
+                    reason = reason or f"a line of more than {MAX_LINE} characters"
+                long_line = cut
+                if reason is None:
+                    yield lineno, piece
+                else:
+                    junk.add(lineno, start, offset, reason)
+    junk.size = offset
+
 
 def read_carmen(path: str | PathLike[str], max_range: float | None = None) -> Log:
     """Read the laser scans, their odometry and the laser's mount from a CARMEN text log.
@@ -547,7 +644,7 @@ def read_carmen(path: str | PathLike[str], max_range: float | None = None) -> Lo
     Parameters
     ----------
     path : str or path-like
-        The ``.clf``/``.log`` file.
+        The ``.clf``/``.log`` file (UTF-8 text; not compressed).
     max_range : float, optional
         The laser's maximum range in metres (readings at or beyond it mean "no return").
         Default: the log's "no return" code (:func:`fhslam.io.log.no_return_reading`, e.g.
@@ -581,17 +678,24 @@ def read_carmen(path: str | PathLike[str], max_range: float | None = None) -> Lo
         from the first scan's,
         a malformed or contradictory ``PARAM`` of the mount or beam layout, a resolution
         that spreads the beams over more than 360° (or that contradicts the stated field of
-        view), or a file with no laser messages or with both FLASER and ROBOTLASER1.
+        view), or a file with no laser messages (``"{path}: not a CARMEN text log: ..."``
+        if it has lines that are not text) or with both FLASER and ROBOTLASER1.
 
     Warns
     -----
     CarmenWarning
-        When the ``PARAM`` mount and the constant offset of the laser poses disagree; where
+        For lines that are not text (NUL bytes, bytes that are not UTF-8, longer than
+        :data:`MAX_LINE`), skipped: one warning naming the line and byte where they start
+        and how many bytes (the module docstring);
+        when the ``PARAM`` mount and the constant offset of the laser poses disagree; where
         the scans' time runs backwards, repeats or leaps forward more than a day, or the
         odometry jumps
         (:func:`fhslam.io.log.check_sequence`); for readings that are negative, NaN,
         infinite or beyond 1000 m (read as no return), scans without a return, more than
         10,000 beams (:func:`fhslam.io.log.check_readings`). Each names the file and line.
+        Without ``max_range``: when the maximum range found is well below readings the log
+        repeats, which are then read as no return
+        (:func:`fhslam.io.log.effective_max_range`).
     """
     path = input_path(path, "CARMEN log")
     stamps: list[float] = []
@@ -601,59 +705,72 @@ def read_carmen(path: str | PathLike[str], max_range: float | None = None) -> Lo
     laser_poses: list[NDArray] = []
     params: dict[str, _Param] = {}
     first: tuple[str, int, int, NDArray | None] | None = None  # kind, lineno, n, geometry
-    try:
-        with reading(path), path.open(encoding="utf-8") as f:
-            for lineno, line in enumerate(f, start=1):
-                fields = line.split()
-                if not fields or fields[0].startswith("#"):
-                    continue
-                if fields[0] == "PARAM":
-                    _read_param(fields, f"{path}:{lineno}", lineno, params)
-                    continue
-                if fields[0] not in _PARSERS:
-                    continue
-                kind, where = fields[0], f"{path}:{lineno}"
-                stamp, r, odom, laser_pose, geom = _PARSERS[kind](fields, where)
-                if first is None:
-                    first = (kind, lineno, len(r), geom)
-                    if len(r) == 0:
-                        raise CarmenFormatError(f"{where}: {kind} scan has no readings")
-                elif kind != first[0]:
-                    raise CarmenFormatError(
-                        f"{where}: {kind} after {first[0]} messages (line {first[1]}); logs "
-                        "mixing both laser messages are not supported"
-                    )
-                elif len(r) != first[2]:
-                    raise CarmenFormatError(
-                        f"{where}: {kind} has {len(r)} readings but the first scan (line "
-                        f"{first[1]}) has {first[2]}; varying beam counts are not supported"
-                    )
-                elif geom is not None and not np.allclose(geom[:2], first[3][:2]):
-                    raise CarmenFormatError(
-                        f"{where}: ROBOTLASER1 start_angle/angular_resolution {geom[:2]} differ"
-                        f" from the first scan's {first[3][:2]} (line {first[1]})"
-                    )
-                stamps.append(stamp)
-                scan_lines.append(lineno)
-                ranges.append(r)
-                odometry.append(odom)
-                laser_poses.append(laser_pose)
-    except UnicodeDecodeError as e:
-        raise CarmenFormatError(f"{path}: not a CARMEN text log ({e.reason})") from None
+    junk = _Unreadable()
+    with reading(path):
+        for lineno, line in _text_lines(path, junk):
+            fields = line.split()
+            if not fields or fields[0].startswith("#"):
+                continue
+            if fields[0] == "PARAM":
+                _read_param(fields, f"{path}:{lineno}", lineno, params)
+                continue
+            if fields[0] not in _PARSERS:
+                continue
+            kind, where = fields[0], f"{path}:{lineno}"
+            stamp, r, odom, laser_pose, geom = _PARSERS[kind](fields, where)
+            if first is None:
+                first = (kind, lineno, len(r), geom)
+                if len(r) == 0:
+                    raise CarmenFormatError(f"{where}: {kind} scan has no readings")
+            elif kind != first[0]:
+                raise CarmenFormatError(
+                    f"{where}: {kind} after {first[0]} messages (line {first[1]}); logs "
+                    "mixing both laser messages are not supported"
+                )
+            elif len(r) != first[2]:
+                raise CarmenFormatError(
+                    f"{where}: {kind} has {len(r)} readings but the first scan (line "
+                    f"{first[1]}) has {first[2]}; varying beam counts are not supported"
+                )
+            elif geom is not None and not np.allclose(geom[:2], first[3][:2]):
+                raise CarmenFormatError(
+                    f"{where}: ROBOTLASER1 start_angle/angular_resolution {geom[:2]} differ"
+                    f" from the first scan's {first[3][:2]} (line {first[1]})"
+                )
+            stamps.append(stamp)
+            scan_lines.append(lineno)
+            ranges.append(r)
+            odometry.append(odom)
+            laser_poses.append(laser_pose)
     if first is None:
+        if junk.lines:
+            gz = "gzip-compressed (decompress it first, e.g. gunzip); " if junk.gzip else ""
+            raise CarmenFormatError(
+                f"{path}: not a CARMEN text log: {gz}{junk.describe()}, and no FLASER or "
+                "ROBOTLASER1 laser messages"
+            )
         raise CarmenFormatError(f"{path}: no FLASER or ROBOTLASER1 laser messages found")
+    if junk.lines:
+        warnings.warn(
+            f"{path}:{junk.first_line}: skipped {junk.describe()}; read the {len(stamps)} "
+            "laser scans of the other lines",
+            CarmenWarning,
+            stacklevel=2,
+        )
 
     kind, first_line, n, geom = first
     r = np.vstack(ranges)
     stated = None if kind == "FLASER" else float(geom[2])
     if kind == "FLASER":
         angles = _flaser_layout(path, params, n, first_line)
-        inferred, _ = effective_max_range(r, None, FLASER_MAX_RANGE)
     else:
         angles = geom[0] + np.arange(n) * geom[1]
-        inferred, _ = effective_max_range(r, stated, stated)
+    if max_range is None:
+        default = FLASER_MAX_RANGE if stated is None else stated
+        max_range, _ = effective_max_range(r, stated, default, path, CarmenWarning)
+    else:
+        max_range = float(max_range)
     odo = np.vstack(odometry)
-    max_range = inferred if max_range is None else float(max_range)
     check_sequence(path, np.array(stamps), odo, scan_lines, CarmenWarning)
     check_readings(path, r, max_range, scan_lines, CarmenWarning)
     mount, source = _laser_mount(path, kind, params, odo, np.vstack(laser_poses))

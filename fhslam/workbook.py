@@ -4,7 +4,12 @@ them for a class.
 - :func:`run_notebook` executes a notebook in a fresh kernel and writes it back with its new
   outputs (atomically: an interrupted run leaves the old file), timing every cell;
   ``fhslam run-notebooks`` does it for the whole folder — the one command that regenerates
-  the committed outputs.
+  the committed outputs. What changes from run to run without the notebook changing is not
+  kept, or does not count: the cells' execution times are left out, printed text is kept in
+  one piece per stream, the widgets' random model ids are renumbered in a fixed order, and the
+  outputs of cells tagged ``timing`` (times measured on the machine) are left out of the
+  comparison with the file. A notebook whose outputs come out the same otherwise is not
+  written at all, so that re-running unchanged notebooks leaves ``git status`` clean.
 - Every notebook ``NN_topic.ipynb`` is paired with ``NN_topic.py``, its plain-text source in
   jupytext's percent format (cells separated by ``# %%`` lines, markdown as comments, tags
   kept), so that a change to a notebook reads as a diff of its ``.py``. :func:`pair` writes
@@ -12,12 +17,17 @@ them for a class.
   by hand, ``jupytext --sync notebooks/NN_topic.py`` carries the change into the notebook,
   keeping its outputs. The pairing is stated in each notebook's metadata, so JupyterLab with
   the jupytext extension saves both files.
-- :func:`student_copy` writes the notebooks without their solution cells and outputs.
+- :func:`student_copy` writes the notebooks without their solution cells and outputs; the
+  sentence of the exercises that points to the solution (:data:`SOLUTION_NOTE`) says instead
+  that the copy has none (:data:`STUDENT_NOTE`).
 """
 
 from __future__ import annotations
 
+import json
+import re
 import time
+import uuid
 from dataclasses import dataclass
 from os import PathLike
 from pathlib import Path
@@ -28,6 +38,9 @@ from fhslam.io.files import atomic_output, output_batch, output_folder, reading
 __all__ = [
     "FORMATS",
     "RESULTS",
+    "SOLUTION_NOTE",
+    "STUDENT_NOTE",
+    "TIMING",
     "NotebookRun",
     "notebooks_in",
     "pair",
@@ -49,6 +62,17 @@ _JUPYTEXT = {
     "formats": FORMATS,
     "notebook_metadata_filter": "-jupytext.text_representation.jupytext_version",
 }
+
+#: The tag of a cell whose outputs are times measured on the machine: they differ from run to
+#: run, so :func:`run_notebook` does not write a notebook for them alone.
+TIMING = "timing"
+
+#: The sentence of every exercise's task that points to its solution cell, in the notebooks;
+#: :func:`student_copy` replaces it with :data:`STUDENT_NOTE`.
+SOLUTION_NOTE = "A solution is hidden under the check (click the collapsed cell to show it)."
+
+#: What the student copy says instead of :data:`SOLUTION_NOTE`.
+STUDENT_NOTE = "This copy of the workbook comes without the solutions."
 
 
 def notebooks_in(folder: str | PathLike[str]) -> list[Path]:
@@ -87,20 +111,139 @@ def paired_text(nb) -> str:
     return jupytext.writes(nb, fmt="py:percent")
 
 
-def _write(nb, path: Path) -> None:
+_WIDGET_STATE = "application/vnd.jupyter.widget-state+json"
+_WIDGET_VIEW = "application/vnd.jupyter.widget-view+json"
+_MODEL = re.compile(r"IPY_MODEL_([0-9a-zA-Z_-]+)")
+
+
+def _widgets(nb) -> tuple[dict, list[dict]]:
+    """The widget states saved in ``nb``'s metadata (model id -> state) and the widget views
+    in its outputs, in order."""
+    state = nb.metadata.get("widgets", {}).get(_WIDGET_STATE, {}).get("state", {})
+    views = [
+        o["data"][_WIDGET_VIEW]
+        for c in nb.cells
+        for o in c.get("outputs", [])
+        if isinstance(o.get("data", {}).get(_WIDGET_VIEW), dict)
+    ]
+    return state, views
+
+
+def _shown(state: dict, views: list[dict]) -> list[str]:
+    """The models the ``views`` show, then the models each refers to, depth first."""
+    order: list[str] = []
+
+    def visit(model: str) -> None:
+        if model in state and model not in order:
+            order.append(model)
+            for ref in _MODEL.findall(json.dumps(state[model], sort_keys=True)):
+                visit(ref)
+
+    for view in views:
+        visit(view.get("model_id", ""))
+    return order
+
+
+def _renumber_widgets(nb) -> None:
+    """Give the widgets saved in ``nb`` (their state in the metadata, their views in the
+    outputs) model ids in a fixed order instead of the kernel's random ones: the views' models
+    in the order of the outputs, then the models each refers to, depth first; any left over in
+    the order of their state with the ids left out."""
+    state, views = _widgets(nb)
+    order = _shown(state, views)
+    rest = sorted(
+        (m for m in state if m not in order),
+        key=lambda m: _MODEL.sub("", json.dumps(state[m], sort_keys=True)),
+    )
+    order += [m for m in _shown(state, [{"model_id": m} for m in rest]) if m not in order]
+    new = {m: uuid.uuid5(uuid.NAMESPACE_URL, f"fhslam-widget-{i}").hex for i, m in enumerate(order)}
+
+    def renamed(value):
+        if isinstance(value, str):
+            return _MODEL.sub(lambda m: f"IPY_MODEL_{new.get(m[1], m[1])}", value)
+        if isinstance(value, list):
+            return [renamed(v) for v in value]
+        if isinstance(value, dict):
+            return {k: renamed(v) for k, v in value.items()}
+        return value
+
+    if state:
+        nb.metadata["widgets"][_WIDGET_STATE]["state"] = {new[m]: renamed(state[m]) for m in order}
+    for view in views:
+        view["model_id"] = new.get(view.get("model_id"), view.get("model_id"))
+
+
+def _normalize(nb) -> None:
+    """Leave out of ``nb`` what a run changes by itself: the cells' execution times (kept in
+    their metadata by nbclient), how a cell's printed text happened to be cut into pieces on
+    its way from the kernel (consecutive pieces of one stream joined, as they are shown) and
+    the widgets' random model ids (renumbered)."""
+    for c in nb.cells:
+        c.get("metadata", {}).pop("execution", None)
+        joined: list = []
+        for o in c.get("outputs", []):
+            last = joined[-1] if joined else None
+            if (
+                o.get("output_type") == "stream"
+                and last is not None
+                and last.get("output_type") == "stream"
+                and last.get("name") == o.get("name")
+            ):
+                last["text"] += o["text"]
+            else:
+                joined.append(o)
+        if "outputs" in c:
+            c.outputs = joined
+    _renumber_widgets(nb)
+
+
+def _comparable(nb) -> str:
+    """``nb`` as text without what differs between two runs of an unchanged notebook: the
+    volatile parts (:func:`_normalize`), the outputs of the cells tagged :data:`TIMING`, and
+    the state of widgets no other output shows (a progress bar's rate, say)."""
+    import copy
+
     import nbformat
 
+    nb = copy.deepcopy(nb)
+    _normalize(nb)
+    for c in nb.cells:
+        if TIMING in c.get("metadata", {}).get("tags", []):
+            c.outputs = []
+    state, views = _widgets(nb)
+    if state:
+        shown = set(_shown(state, views))
+        nb.metadata["widgets"][_WIDGET_STATE]["state"] = {
+            m: s for m, s in state.items() if m in shown
+        }
+    return nbformat.writes(nb)
+
+
+def _write(nb, path: Path) -> bool:
+    """Write notebook ``nb`` to ``path`` and its paired ``.py`` beside it, each only where it
+    differs from the file there: the notebook not at all if it differs only in what a run
+    changes by itself (:func:`_comparable`). Returns whether the notebook was written."""
+    import nbformat
+
+    _normalize(nb)
     text = paired_text(nb)  # sets the pairing in nb's metadata first
+    py = paired_path(path)
+    old = _read(path) if path.exists() else None
+    write_nb = old is None or _comparable(old) != _comparable(nb)
+    write_py = not py.exists() or py.read_text() != text
     with output_batch():  # the notebook and its .py together, or neither
-        with atomic_output(path) as f:
-            nbformat.write(nb, f)
-        with atomic_output(paired_path(path)) as f:
-            f.write(text)
+        if write_nb:
+            with atomic_output(path) as f:
+                nbformat.write(nb, f)
+        if write_py:
+            with atomic_output(py) as f:
+                f.write(text)
+    return write_nb
 
 
 def pair(path: str | PathLike[str]) -> Path:
     """Write the ``.py`` paired with notebook ``path`` (and the pairing into the notebook's
-    metadata); returns the ``.py``'s path."""
+    metadata, if it lacks it); returns the ``.py``'s path."""
     p = Path(path)
     _write(_read(p), p)
     return paired_path(p)
@@ -108,18 +251,21 @@ def pair(path: str | PathLike[str]) -> Path:
 
 @dataclass(frozen=True)
 class NotebookRun:
-    """One notebook run: ``seconds`` for Run All, and the slowest code cell's ``index`` (in
-    the notebook, from 0) and ``seconds``."""
+    """One notebook run: ``seconds`` for Run All, the slowest code cell's ``index`` (in the
+    notebook, from 0) and ``seconds``, and whether the notebook was ``written`` (not when its
+    outputs came out as they were)."""
 
     path: Path
     seconds: float
     slowest_cell: int
     slowest_seconds: float
+    written: bool = True
 
     def __str__(self) -> str:
         return (
             f"{self.path}: Run All {self.seconds:.1f} s, slowest cell "
             f"{self.slowest_cell} ({self.slowest_seconds:.1f} s)"
+            + ("" if self.written else "; outputs unchanged, not written")
         )
 
 
@@ -137,7 +283,9 @@ def _cell_seconds(cell) -> float:
 
 def run_notebook(path: str | PathLike[str], timeout: float = 600.0) -> NotebookRun:
     """Execute notebook ``path`` in a fresh ``python3`` kernel, in its own folder, and write it
-    back with the new outputs and its paired ``.py``. A cell that raises (or kills the
+    back with the new outputs and its paired ``.py`` — unless the outputs came out as they were
+    (apart from execution times, widget ids and the outputs of cells tagged :data:`TIMING`):
+    then the notebook is left as it is. A cell that raises (or kills the
     kernel) stops the run: the error is an :class:`~fhslam.errors.InputError` naming the
     notebook and the cell, and the file is left as it was. ``timeout`` is per cell, in
     seconds. The kernel's own log (its stderr: connection warnings, and its tracebacks when
@@ -198,8 +346,8 @@ def run_notebook(path: str | PathLike[str], timeout: float = 600.0) -> NotebookR
     seconds = time.perf_counter() - t0
     times = [(_cell_seconds(c), i) for i, c in enumerate(nb.cells) if c.cell_type == "code"]
     slow, index = max(times, default=(0.0, -1))
-    _write(nb, p)
-    return NotebookRun(p, seconds, index, slow)
+    written = _write(nb, p)
+    return NotebookRun(p, seconds, index, slow, written)
 
 
 def _is_solution(cell: dict) -> bool:
@@ -208,9 +356,10 @@ def _is_solution(cell: dict) -> bool:
 
 def student_copy(source: str | PathLike[str], out: str | PathLike[str]) -> list[tuple[Path, int]]:
     """Write every notebook of folder ``source`` to folder ``out`` without its solution cells
-    (cells tagged ``solution``) and without outputs; returns ``(path, solutions removed)`` per
-    notebook. ``out`` must not be ``source``. The copies are not paired with a ``.py``; the
-    results the notebooks load (folder ``results``) are copied with them.
+    (cells tagged ``solution``) and without outputs, :data:`SOLUTION_NOTE` replaced by
+    :data:`STUDENT_NOTE` in its text; returns ``(path, solutions removed)`` per notebook.
+    ``out`` must not be ``source``. The copies are not paired with a ``.py``; the results the
+    notebooks load (folder ``results``) are copied with them.
 
     Every notebook is read and checked before anything is written, and the copies appear
     together once all are written, or none (:func:`~fhslam.io.files.output_batch`): a broken
@@ -240,6 +389,8 @@ def student_copy(source: str | PathLike[str], out: str | PathLike[str]) -> list[
         for c in nb.cells:
             if c.cell_type == "code":
                 c.outputs, c.execution_count = [], None
+            elif c.cell_type == "markdown":
+                c.source = c.source.replace(SOLUTION_NOTE, STUDENT_NOTE)
         try:
             text = nbformat.writes(nb)
         except Exception as e:  # nbformat raises several types for an invalid notebook

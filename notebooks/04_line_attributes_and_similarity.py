@@ -97,8 +97,6 @@ def solution_observation(rho, theta, pose):
     return int(np.sign(s)), abs(s)
 
 
-print(check_observation(solution_observation, line6, pose6))
-
 # %% [markdown]
 # ## Figs. 7–10 — similar or not?
 # Thresholds are the defaults of `fhslam.matching.MatchParams`: 5°, 15 cm, overlap ≥ 0.
@@ -126,7 +124,7 @@ for fig, (ref, new, pose) in similarity_examples().items():
 # %% [markdown]
 # ## Explore the four conditions
 #
-# The reference line of Fig. 7 (grey) and a new line, green when the two are similar and red when not, seen by the robot below them. The first slider **turns** the new line about its middle, the next two **move** it square to the reference and **slide** it along it; the last two set the thresholds of (b) and (c) (the grey band is (c)'s distance either side of the reference). The title gives each condition's number and verdict. Turn the new line one degree at a time: at what turn does (b) fail, and at what turn does (c) fail too (the endpoints are 1.1 m from the middle)? Slide it off the end of the reference for (d); move it across to below the robot for (a). The figure above the sliders is what the saved notebook shows; the sliders need a running kernel.
+# The reference line of Fig. 7 (grey) and a new line, green when the two are similar and red when not, seen by the robot below them. The first slider **turns** the new line about its middle, the next two **move** it square to the reference and **slide** it along it; the last two set the thresholds of (b) and (c), each drawn where it acts: the blue wedge through the new line's middle holds the directions within (b)'s angle of the reference's, and the grey band is (c)'s distance either side of the reference. The title gives each condition's number and verdict. Turn the new line one degree at a time: at what turn does (b) fail, and at what turn does (c) fail too (the endpoints are 1.1 m from the middle)? Slide it off the end of the reference for (d); move it across to below the robot for (a). The figure above the sliders is what the saved notebook shows; the sliders need a running kernel.
 
 # %% tags=["nbval-ignore-output"]
 from fhslam.figures.explorers import similarity_explorer
@@ -162,7 +160,7 @@ plt.show()
 # %% [markdown]
 # ## Exercise 4.2 (predict) — which condition tells the two faces apart?
 #
-# With the default thresholds (5°, 0.15 m, overlap ≥ 0), which of the conditions (a)–(d) does the pair `south`, `north` fail? **Before running the cell under this exercise** (it prints `similarity(south, north)`), write the letters of the failing conditions as a string, e.g. `"b"` or `"bd"`, or `"none"` if you think the two lines are similar: the same line, to be merged. The check computes the answer with `fhslam.matching.similarity` and explains each condition you get wrong.
+# With the default thresholds (5°, 0.15 m, overlap ≥ 0), which of the conditions (a)–(d) does the pair `south`, `north` fail? **Before running the cell under this exercise** (it prints `similarity(south, north)`), write the letters of the failing conditions as a string, e.g. `"b"` or `"bd"`, or `"none"` if you think the two lines are similar: the same line, to be merged. The check computes the answer with `fhslam.matching.similarity`; once your letters are right, it explains every condition with its numbers.
 #
 # Fill in the cell below, then run it and the check under it. A solution is hidden under the check (click the collapsed cell to show it).
 
@@ -177,7 +175,7 @@ print(check_failing_conditions(my_prediction, south, north))
 # %% jupyter={"outputs_hidden": true, "source_hidden": true} tags=["solution", "nbval-check-output"]
 # Solution
 # Parallel, 10 cm apart and overlapping: (b), (c), (d) hold. dir +1 and -1: (a) fails.
-print(check_failing_conditions("a", south, north))
+solution_prediction = "a"
 
 # %%
 # NBVAL_CHECK_OUTPUT
@@ -262,7 +260,7 @@ print(check_vanished_lines_reading(my_answer))
 # %% jupyter={"outputs_hidden": true, "source_hidden": true} tags=["solution", "nbval-check-output"]
 # Solution
 # At scan 205 the robot is about 1 cm from that wall's line: the wall is edge-on, no line.
-print(check_vanished_lines_reading("b"))
+solution_answer = "b"
 
 # %% [markdown]
 # ## Summary

@@ -101,7 +101,7 @@ print(check_merge_reading(my_answer))
 # %% jupyter={"outputs_hidden": true, "source_hidden": true} tags=["solution", "nbval-check-output"]
 # Solution
 # One line through all the points: AB's sit 3-6 cm above EF's and mostly left of them.
-print(check_merge_reading("b"))
+solution_answer = "b"
 
 # %% [markdown]
 # ## Self-calibration recovers a known pose error
@@ -164,8 +164,13 @@ plt.show()
 # the distance gate of the similarity test (notebook 04; the cells above use 0.6 m, the
 # package's default is 0.15 m), *threshold (b)* its angle threshold, and the last slider the
 # Gauss-Newton iterations. Left, the new lines at the predicted pose (solid: matched to a
-# reference line, dashed: not matched); right, after the calibration; the hollow triangle is the
-# true pose. The title says how many lines are matched and what they fix.
+# reference line, dashed: not matched); middle, after the calibration; the hollow triangle is the
+# true pose. Top right, thresholds (b) and (c) where they act: each new line at the predicted
+# pose as a point, its angle to a reference line across and the distance of the endpoints up; a
+# line inside the shaded box of the two thresholds is matched (filled), one outside is not
+# (hollow). Below it, what the iterations minimise: the rms distance of the matched lines'
+# endpoints to their reference lines after each round, the rounds applied in red, the others
+# dotted. The title says how many lines are matched and what they fix.
 #
 # Things to try:
 #
@@ -174,7 +179,8 @@ plt.show()
 # - lower the gate (c) to 0.15 m, set the heading error to 0 and find the largest forward error
 #   still recovered; at 20 cm, which lines stay matched, and why does the calibration keep the
 #   error (the corridor below)?
-# - set the iterations to 0, 1 and 2: the table above, for an error of your own.
+# - set the iterations to 0, 1 and 2: the table above, for an error of your own; on the right,
+#   after how many rounds does another one change nothing?
 
 # %% tags=["nbval-ignore-output"]
 from fhslam.figures.explorers import calibration_explorer
@@ -225,7 +231,6 @@ print(check_corridor_pose(my_pose, seen, corridor, pairs, wrong))
 # The walls' direction fixes the heading (0) and their distances y (1 m, midway); along the
 # corridor they look the same from everywhere: x stays the odometry's 5.4 m.
 solution_pose = (5.4, 1.0, 0.0)
-print(check_corridor_pose(solution_pose, seen, corridor, pairs, wrong))
 
 # %%
 # NBVAL_CHECK_OUTPUT
@@ -279,9 +284,6 @@ print(check_heading_correction(my_heading_correction))
 def solution_heading_correction(theta_observed, theta_reference, weights):
     diff = wrap_angle(theta_reference - theta_observed)  # each difference to (-pi, pi]
     return float(np.sum(weights * diff) / np.sum(weights))
-
-
-print(check_heading_correction(solution_heading_correction))
 
 # %% [markdown]
 # ## Summary

@@ -2,8 +2,9 @@
 (Debian's ``chromium`` and ``chromium-driver``; never a downloaded browser) through Selenium.
 
 For every notebook, as a student would: open it, Run All, and require no error output, every
-figure rendered, every widget live and each explorer's figure changing when a slider moves;
-then answer every exercise wrong (the check must say "not yet") and right (it must say
+figure rendered, no solution given away (no "correct" verdict anywhere in the page, no output
+under a solution cell), every widget live and each explorer's figure changing when a slider
+moves; then answer every exercise wrong (the check must say "not yet") and right (it must say
 "correct"), typing into the exercise cell and running it and its check.
 
 The notebooks run from a copy in a temporary folder, so nothing here changes them. Skipped,
@@ -228,6 +229,11 @@ def _output_text(cell) -> str:
     )
 
 
+def _outputs(cell) -> int:
+    """How many outputs the cell's output area holds (shown or collapsed)."""
+    return len(cell.find_elements(By.CSS_SELECTOR, ".jp-OutputArea-output"))
+
+
 def _type_and_run(driver, cell, source: str) -> None:
     """Replace the cell's code with one line ``source`` and run it (Shift+Enter)."""
     editor = cell.find_element(By.CSS_SELECTOR, ".cm-content")
@@ -263,17 +269,21 @@ def _check_call(source: str) -> ast.Call:
 
 def answers(task: str, check: str, solution: str) -> tuple[str, str]:
     """One wrong and one right answer for an exercise, each one line for its cell: the
-    student's name is the first argument of the check cell's check call; the right answer is
-    what the solution cell passes to the same check (names it defined are live after Run
-    All); the wrong one a function returning None or the number -12345."""
+    student's name ``my_x`` is the first argument of the check cell's check call; the right
+    answer is the solution cell's ``solution_x`` (live after Run All); the wrong one a
+    function returning None or the number -12345."""
     name = _check_call(check).args[0]
     assert isinstance(name, ast.Name), f"the check's first argument is not a name: {check!r}"
-    right = ast.get_source_segment(solution, _check_call(solution).args[0])
+    assert name.id.startswith("my_"), f"the student's name is not my_...: {check!r}"
+    right = "solution_" + name.id[3:]
+    assert re.search(rf"^(def {right}\b|{right} =)", solution, re.M), (
+        f"the solution cell defines no {right}: {solution!r}"
+    )
     if re.search(rf"def {name.id}\b", task):
         wrong = f"{name.id} = lambda *args, **kwargs: None"
     else:
         wrong = f"{name.id} = -12345.0"
-    return wrong, f"{name.id} = {' '.join(right.split())}"
+    return wrong, f"{name.id} = {right}"
 
 
 def exercises(nb):
@@ -285,15 +295,17 @@ def exercises(nb):
 def test_answers_are_derived_from_the_check_and_solution_cells():
     task = "def my_f(x):\n    raise NotImplementedError"
     check = "from fhslam.exercises.nb02 import check_f\n\nprint(check_f(my_f, data))"
-    solution = "# Solution\ndef solution_f(x):\n    return x\n\n\nprint(check_f(solution_f, data))"
+    solution = "# Solution\ndef solution_f(x):\n    return x"
     assert answers(task, check, solution) == (
         "my_f = lambda *args, **kwargs: None",
         "my_f = solution_f",
     )
-    assert answers("my_x = ...", "print(check_x(my_x))", 'print(check_x("b"))') == (
+    assert answers("my_x = ...", "print(check_x(my_x))", '# Solution\nsolution_x = "b"') == (
         "my_x = -12345.0",
-        'my_x = "b"',
+        "my_x = solution_x",
     )
+    with pytest.raises(AssertionError, match="defines no solution_x"):
+        answers("my_x = ...", "print(check_x(my_x))", 'print(check_x("b"))')
 
 
 # --- the test -----------------------------------------------------------------------------
@@ -337,6 +349,16 @@ def test_notebook_in_jupyterlab(path, lab, browser):
     ]
     assert not broken, f"{path.name}: {len(broken)} figures not rendered"
     print(f"{path.name}: Run All {seconds:.0f} s in JupyterLab, {len(images)} figures")
+
+    # no solution given away: the checks of the unfilled cells say "not attempted", and the
+    # solution cells, run too, show nothing (no verdict, no number)
+    page = driver.find_element(By.TAG_NAME, "body").text
+    assert "✅ correct" not in page and "❌ not yet" not in page, f"{path.name}: a verdict shows"
+    said = [c for c in nb.cells if "check" in c.metadata.get("tags", [])]
+    assert page.count("⏳ not attempted yet") == len(said), f"{path.name}: checks not run"
+    solutions = [i for i, c in enumerate(nb.cells) if "solution" in c.metadata.get("tags", [])]
+    shown = {i: _output_text(cells[i]) for i in solutions if _outputs(cells[i])}
+    assert not shown, f"{path.name}: solution cells with an output after Run All: {shown}"
 
     # widgets: rendered as widgets (not as text), each explorer's figure follows its sliders
     assert "interactive(children=" not in driver.find_element(By.TAG_NAME, "body").text

@@ -66,13 +66,17 @@ def test_corridor_pose_keeps_the_odometry_along_the_corridor():
 def test_corridor_pose_names_the_direction_that_is_wrong():
     full = corridor((5.0, 1.0, 0.0))  # the true pose: "the calibration fixes everything"
     assert full.status == "wrong" and "along the corridor" in full.message
-    assert "40 cm" in full.message and "keeps the odometry" in full.message and one_line(full)
+    assert "parallel walls" in full.message and one_line(full)
     across = corridor((5.4, 1.1, 0.0))  # the odometry's y kept
     assert across.status == "wrong" and "across the corridor" in across.message
-    assert "10 cm" in across.message
+    assert "distances to the two walls" in across.message
     heading = corridor((5.4, 1.0, 0.02))  # the odometry's heading kept
-    assert heading.status == "wrong" and "fixes the heading" in heading.message
-    assert corridor(PREDICTED).status == "wrong"  # nothing corrected
+    assert heading.status == "wrong" and "walls' direction" in heading.message
+    nothing = corridor(PREDICTED)  # nothing corrected
+    assert nothing.status == "wrong"
+    for wrong in (full, across, heading, nothing):  # a prediction: the pose is not given away
+        assert "calibrated (" not in wrong.message and "5.40" not in wrong.message, wrong
+        assert "40 cm" not in wrong.message and "10 cm" not in wrong.message, wrong
     # another odometry, another answer: 30 cm back along the corridor is kept
     assert corridor((4.7, 1.0, 0.0), np.array([4.7, 0.95, -0.01]))
     assert corridor((5.4, 1.0, 0.0), np.array([4.7, 0.95, -0.01])).status == "wrong"

@@ -1,9 +1,12 @@
-"""The notebooks' explorers: each draws a labelled figure, follows its sliders, and shows a
+"""The notebooks' explorers: each draws a labelled figure, follows its sliders — every one of
+them changes what the figure draws in one step, not only a number in a title —, and shows a
 static image plus a plain-text line when saved (no ``interactive(children=...`` text)."""
 
 import matplotlib
 
 matplotlib.use("Agg")
+
+import io
 
 import IPython.display
 import matplotlib.pyplot as plt
@@ -11,17 +14,92 @@ import pytest
 
 from fhslam.figures import figure_scan, paper_log
 from fhslam.figures.explorers import (
+    Explorer,
     calibration_explorer,
     clustering_explorer,
     extraction_explorer,
     similarity_explorer,
     slam_noise_explorer,
+    slider,
 )
 
 
 @pytest.fixture(scope="module")
 def log():
     return paper_log(0)
+
+
+#: Each explorer as its notebook makes it (notebooks 02-06; SEED = 0, k = figure_scan or 200).
+EXPLORERS = {
+    "clustering": lambda log: clustering_explorer(log, figure_scan(log)),
+    "extraction": lambda log: extraction_explorer(log, figure_scan(log)),
+    "similarity": lambda log: similarity_explorer(),
+    "calibration": lambda log: calibration_explorer(log, 200),
+    "slam_noise": lambda log: slam_noise_explorer(0),
+}
+
+
+def drawing(explorer) -> bytes:
+    """The figure as a PNG with every text blanked: the figure's and each axes' titles, the
+    legends' entries, the notes in the axes and on the figure. What is left is what is drawn:
+    a slider that only changes a number in a title or a legend leaves it as it was."""
+    fig = explorer.figure()
+    texts = [*fig.texts, *(t for lg in fig.legends for t in lg.get_texts())]
+    if fig._suptitle is not None:
+        texts.append(fig._suptitle)
+    for ax in fig.axes:
+        texts += [ax.title, ax._left_title, ax._right_title, *ax.texts]
+        if ax.get_legend() is not None:
+            texts += ax.get_legend().get_texts()
+    for text in texts:
+        text.set_text("")
+    buf = io.BytesIO()
+    fig.savefig(buf, format="png", dpi=80)  # as Explorer.png shows it
+    plt.close(fig)
+    return buf.getvalue()
+
+
+@pytest.mark.parametrize("name", EXPLORERS)
+def test_every_slider_changes_the_drawing_in_one_step(name, log):
+    """From the defaults, one step of any slider (up, or down from the top) draws another
+    figure, its texts left out: no slider a student moves in vain there, nor one that only
+    changes a number in a title."""
+    e = EXPLORERS[name](log)
+    start = drawing(e)
+    same = []
+    for control, widget in e.controls.items():
+        value = widget.value
+        moved = value + widget.step if value + widget.step <= widget.max else value - widget.step
+        e.set(**{control: moved})
+        if drawing(e) == start:
+            same.append(f"{control} {value:g} -> {moved:g}")
+        e.set(**{control: value})
+    assert not same, f"{name}: one step draws the same figure, texts aside, for {same}"
+    assert drawing(e) == start  # the same values draw the same figure: the changes are real
+
+
+def test_a_change_in_the_texts_alone_is_not_a_change_of_the_drawing():
+    """The comparison above is blind to numbers in titles, legends and notes, and sees a
+    threshold line move by one step."""
+
+    def draw(value, line):
+        fig, (ax, other) = plt.subplots(1, 2)
+        fig.suptitle(f"value {value}")
+        ax.set_title(f"value {value}")
+        ax.plot([0, 1], [line, line], label=f"value {value}")
+        ax.legend()
+        ax.text(0.5, 0.5, f"value {value}")
+        other.set_title(f"value {value}", loc="left")
+        ax.set_ylim(0, 2)
+        return fig
+
+    controls = {"value": slider(1, 0, 9, 1, "value"), "line": slider(1.0, 0.0, 2.0, 0.02, "y")}
+    e = Explorer(draw, controls, "a title and a line")
+    start, png = drawing(e), e.png()
+    e.set(value=2)
+    assert e.png() != png and drawing(e) == start  # only the texts changed
+    e.set(value=1, line=1.02)
+    assert drawing(e) != start  # the line moved
 
 
 def title(explorer) -> str:
@@ -37,13 +115,28 @@ def labelled(explorer) -> bool:
     return all(ax.get_xlabel() for ax in fig.axes) and bool(fig.axes[0].get_ylabel())
 
 
+def axes(explorer, i):
+    fig = explorer.figure()
+    plt.close(fig)
+    return fig.axes[i]
+
+
 def test_clustering_explorer_follows_the_gap(log):
     e = clustering_explorer(log, figure_scan(log))
     assert "5 clusters" in title(e) and labelled(e)
+
+    def gap_panel():  # the threshold line's height and the splits (black crosses)
+        ax = axes(e, 1)
+        (threshold,) = ax.get_lines()
+        return threshold.get_ydata()[0], len(ax.collections[-1].get_offsets())
+
+    assert gap_panel() == (0.3, 4)  # 4 gaps above 0.3 m: 5 clusters
+    e.set(cluster_gap=0.32)  # one step: the line moves, no split does
+    assert gap_panel() == (0.32, 4)
     e.set(cluster_gap=0.04)
-    assert "5 clusters" not in title(e)
+    assert "5 clusters" not in title(e) and gap_panel()[1] > 4
     e.set(cluster_gap=2.0)
-    assert "3 clusters" in title(e)  # as notebook 02's table: 3 clusters at 2 m
+    assert "3 clusters" in title(e) and gap_panel() == (2.0, 2)  # notebook 02's table at 2 m
 
 
 def test_extraction_explorer_follows_its_thresholds(log):
@@ -66,6 +159,23 @@ def test_extraction_explorer_follows_its_thresholds(log):
     assert lines() == 9
     e.set(inlier_dist=0.04, scan=300)
     assert "scan 300:" in title(e)
+
+
+def test_extraction_explorer_draws_each_threshold_where_it_acts(log):
+    e = extraction_explorer(log, figure_scan(log))
+    gap_ax, window_ax, support_ax = (axes(e, i) for i in (1, 2, 3))
+    gap, densify = (line.get_ydata()[0] for line in gap_ax.get_lines())
+    assert (gap, densify) == (0.3, 0.05)
+    (voted,) = window_ax.get_lines()  # the directions the Hough vote tries: every 0.5°
+    assert list(voted.get_xdata()) == [0.5 * k for k in range(-6, 7)]
+    (band,) = support_ax.get_lines()
+    grey, red = (len(c.get_offsets()) for c in support_ax.collections)
+    assert band.get_ydata()[0] == 0.04 and (red, grey) == (180, 1)  # the support of 7 lines
+    e.set(window_deg=3.5, inlier_dist=0.045, cluster_gap=0.35, densify_step=0.06)
+    gap_ax, window_ax, support_ax = (axes(e, i) for i in (1, 2, 3))
+    assert [line.get_ydata()[0] for line in gap_ax.get_lines()] == [0.35, 0.06]
+    assert max(window_ax.get_lines()[0].get_xdata()) == 3.5
+    assert support_ax.get_lines()[0].get_ydata()[0] == 0.045
 
 
 def test_similarity_explorer_shows_each_condition_failing():
@@ -99,7 +209,30 @@ def test_calibration_explorer_recovers_the_pose(log):
     assert "predicted: 25.8 cm" in title(e)
     e.set(dx_cm=20.0, iterations=0)
     assert "calibrated: 25.0 cm" in title(e)  # no iteration: nothing corrected
+    for n in (0, 3, 4):  # the right panel: the rounds applied solid, the others dotted
+        e.set(iterations=n)
+        fig = e.figure()
+        plt.close(fig)
+        applied, more = sorted(fig.axes[2].get_lines(), key=lambda line: line.get_linestyle())
+        assert list(applied.get_xdata()) == list(range(n + 1)), n
+        assert list(more.get_xdata()) == list(range(n, 7)), n
+        residual = applied.get_ydata()
+        assert residual[0] > 100 and (n < 3 or residual[3] <= 1e-9)  # mm: converged at 3
+    e.set(iterations=3)
     assert labelled(e)
+
+    def box():  # the thresholds' box, and the lines inside it (filled) and outside (hollow)
+        ax = axes(e, 3)
+        (rect,) = ax.patches
+        filled = [m.get_markerfacecolor() != "none" for m in ax.get_lines()[1:]]
+        return rect.get_width(), rect.get_height(), sum(filled), len(filled) - sum(filled)
+
+    assert box() == (5.0, 0.6, 8, 0)
+    e.set(dtheta_deg=6.0)  # past (b): every line out of the box, 6° across
+    assert box() == (5.0, 0.6, 0, 8)
+    e.set(max_angle_deg=6.5, gate=0.65)  # the box grows over them
+    assert box() == (6.5, 0.65, 8, 0)
+    e.set(dtheta_deg=3.0, max_angle_deg=5.0, gate=0.6)
     # 20 cm forward at the package's 15 cm gate: only lines (nearly) along the motion match, and
     # the position along them is kept (notebook 05's corridor)
     e.set(dy_cm=0.0, dtheta_deg=0.0, gate=0.15, iterations=3)

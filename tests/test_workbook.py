@@ -1,6 +1,7 @@
 """The workbook's files: every notebook paired with its plain-text source, the command that
 re-runs the notebooks and writes their outputs, and its errors."""
 
+import json
 from pathlib import Path
 
 import nbformat
@@ -80,6 +81,8 @@ def test_the_command(tmp_path, capsys):
     assert main(["run-notebooks", "--notebooks", str(tmp_path), "--pair-only"]) == 0
     assert capsys.readouterr().out == f"{paired_path(path)}: written\n"
     assert not nbformat.read(path, as_version=4).cells[1].outputs  # nothing was run
+    assert main(["run-notebooks", "--notebooks", str(tmp_path), "--pair-only"]) == 0
+    assert capsys.readouterr().out == f"{paired_path(path)}: up to date\n"
     assert main(["run-notebooks", "01", "--notebooks", str(tmp_path)]) == 0
     assert "01_tiny.ipynb: Run All" in capsys.readouterr().out
     assert nbformat.read(path, as_version=4).cells[1].outputs[0].text == "42\n"
@@ -97,3 +100,72 @@ def test_pair_of_an_unreadable_notebook_is_an_input_error(tmp_path):
     bad.write_text("{not json")
     with pytest.raises(InputError, match=r"01_bad\.ipynb: not a readable notebook"):
         pair(bad)
+
+
+WIDGETS = """import ipywidgets as widgets
+box = widgets.VBox([widgets.IntSlider(3, description="n"), widgets.HTML("<b>hi</b>")])
+box"""
+
+
+def test_a_rerun_that_changes_nothing_leaves_the_notebook_as_it_was(tmp_path):
+    """Execution times, the widgets' random model ids and the outputs of a cell tagged
+    ``timing`` differ from run to run: they do not make the notebook written again."""
+    path = tiny(tmp_path, WIDGETS)
+    nb = nbformat.read(path, as_version=4)
+    timed = "import time\nprint(time.perf_counter())\nwidgets.HTML(f'{time.perf_counter()} s')"
+    nb.cells.insert(1, new_code_cell(timed, metadata={"tags": ["timing"]}))  # a progress bar
+    nb.cells[2].source = nb.cells[2].source.replace("import ipywidgets as widgets\n", "")
+    nb.cells[1].source = "import ipywidgets as widgets\n" + nb.cells[1].source
+    nbformat.write(nb, path)
+    assert run_notebook(path, timeout=120).written
+    first = path.read_bytes()
+    saved = nbformat.read(path, as_version=4)
+    assert all("execution" not in c.metadata for c in saved.cells)  # no times kept
+    state = saved.metadata["widgets"]["application/vnd.jupyter.widget-state+json"]["state"]
+    views = [
+        o.data["application/vnd.jupyter.widget-view+json"]["model_id"]
+        for c in saved.cells[1:]
+        for o in c.outputs
+        if "application/vnd.jupyter.widget-view+json" in o.get("data", {})
+    ]
+    assert len(views) == 2 and set(views) <= set(state)  # the progress bar and the box
+    assert len(state) >= 6  # with the box's children and everyone's layout and style
+    assert all(f"IPY_MODEL_{m}" in json.dumps(state) for m in state if m not in views)
+    before = path.stat().st_mtime_ns, paired_path(path).stat().st_mtime_ns
+    again = run_notebook(path, timeout=120)
+    assert not again.written and str(again).endswith("outputs unchanged, not written")
+    assert path.read_bytes() == first  # not even rewritten
+    assert (path.stat().st_mtime_ns, paired_path(path).stat().st_mtime_ns) == before
+
+
+def test_a_notebook_is_written_when_its_outputs_change_and_the_widget_ids_stay(tmp_path):
+    path = tiny(tmp_path, WIDGETS)
+    run_notebook(path, timeout=120)
+    first = nbformat.read(path, as_version=4)
+    nb = nbformat.read(path, as_version=4)
+    nb.cells.append(new_code_cell("print(6 * 7)"))
+    nbformat.write(nb, path)
+    assert run_notebook(path, timeout=120).written
+    second = nbformat.read(path, as_version=4)
+    assert second.cells[2].outputs[0].text == "42\n"
+    assert second.metadata["widgets"] == first.metadata["widgets"]  # the same ids again
+    assert second.cells[1].outputs == first.cells[1].outputs
+    assert "print(6 * 7)" in paired_path(path).read_text()
+
+
+def test_pair_only_does_not_touch_an_unchanged_notebook(tmp_path):
+    path = tiny(tmp_path)
+    run_notebook(path, timeout=120)
+    before = path.stat().st_mtime_ns, paired_path(path).stat().st_mtime_ns
+    assert pair(path) == paired_path(path)
+    assert (path.stat().st_mtime_ns, paired_path(path).stat().st_mtime_ns) == before
+
+
+def test_printed_text_is_kept_as_shown_whatever_pieces_it_came_in(tmp_path):
+    """The kernel sends a cell's printed text in pieces cut by timing: the notebook keeps one
+    output per stream, as JupyterLab shows it, so that the cut does not change the file."""
+    code = "import sys, time\nprint('a')\nsys.stdout.flush()\ntime.sleep(0.3)\nprint('b')"
+    path = tiny(tmp_path, code)
+    run_notebook(path, timeout=120)
+    outputs = nbformat.read(path, as_version=4).cells[1].outputs
+    assert [(o.output_type, o.name, o.text) for o in outputs] == [("stream", "stdout", "a\nb\n")]

@@ -11,6 +11,8 @@ a check here, ``check_…(answer, ...)``, which returns a :class:`Feedback`, sho
 - ``✅ correct: ...`` or ``❌ not yet: ...`` naming the case that failed and a hint.
 
 A student's function that raises is reported the same way, in one line, never as a traceback.
+A wrong prediction is told so with a hint, never with the numbers that decide it (those come in
+the cell the student runs next, and in the message for the right answer).
 The checks of notebook ``NN`` live in :mod:`fhslam.exercises.nbNN` (``from
 fhslam.exercises.nb02 import check_clustering``); this module holds what they share.
 
@@ -18,8 +20,11 @@ In the notebooks an exercise is four cells: a markdown cell ``## Exercise N.k (k
 with the task; the student's cell (tag ``exercise``: a template that raises
 :class:`NotImplementedError` or sets a value to ``...``); the check cell (tag ``check``,
 calling the check on the student's answer); and the solution cell (tag ``solution``, its input
-and output hidden until asked), which runs the same check on the solution. ``fhslam student-copy``
-(:func:`fhslam.workbook.student_copy`) writes the notebooks without their solution cells.
+hidden until asked), which defines the solution — ``solution_x`` for the student's ``my_x`` —
+and shows nothing: Run All gives away no verdict and no number of the solution's. The tests
+run each notebook with the check called on every solution (``tests/test_exercises.py``).
+``fhslam student-copy`` (:func:`fhslam.workbook.student_copy`) writes the notebooks without
+their solution cells.
 """
 
 from __future__ import annotations
@@ -169,9 +174,10 @@ def check_band(
 ) -> Feedback:
     """A predicted range, a letter among ``bands`` (letter -> (lowest, highest, wording), in
     increasing order, each from its lowest value up to the next one's): the right letter is
-    the band holding ``value``. Each choice is explained as its wording and ``shown`` (how
-    ``value`` came about), then ``right`` for the right band, ``too_low`` for a band below it
-    or ``too_high`` for one above it (why the value is not that small or large)."""
+    the band holding ``value``. The right band is explained as its wording, ``shown`` (how
+    ``value`` came about) and ``right``; a band below it gets ``too_low``, one above it
+    ``too_high`` (why the value is not that small or large), without ``shown``: a prediction is
+    made before the numbers are seen, and a wrong one must not give them away."""
     letters = list(bands)
     lows = [low for low, _, _ in bands.values()][1:]
     k = int(np.searchsorted(lows, value, side="right"))
@@ -180,5 +186,5 @@ def check_band(
         if i == k:
             why[letter] = f"{words}: {shown}{right}"
         else:
-            why[letter] = f"{words}: it is {shown}. {too_low if i < k else too_high}"
+            why[letter] = f"{words}: not so. {too_low if i < k else too_high}"
     return check_choice(answer, letters[k], why, what=what)

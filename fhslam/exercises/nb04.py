@@ -214,8 +214,9 @@ def check_failing_conditions(
     """Exercise 4.2 (predict): which of the similarity conditions (a)-(d) the lines ``a`` and
     ``b`` fail, as letters (``"a"``, ``"bd"``, ``"b, d"``) or ``"none"`` when they are
     similar. The right answer is computed here by :func:`fhslam.matching.similarity` (with
-    each line's own ``dir`` unless ``pose`` is given); every condition the answer gets wrong
-    is explained with its numbers."""
+    each line's own ``dir`` unless ``pose`` is given). A wrong answer gets what to ask of
+    each condition, not the numbers that decide it (a prediction); the right one gets every
+    condition explained with its numbers."""
     try:
         said = _letters(answer)
     except ValueError:
@@ -232,8 +233,12 @@ def check_failing_conditions(
     why = _why(s, p, dirs)
     fails = {c for c, (holds, _) in why.items() if not holds}
     if said != fails:
-        wrong = [why[c][1] for c in CONDITIONS if (c in said) != (c in fails)]
-        raise Wrong("; ".join(wrong) + ".")
+        raise Wrong(
+            "not the conditions that fail. For each of (a)-(d) ask: does the robot see both "
+            f"lines from the same side, do they meet at less than {p.max_angle_deg:g}°, do the "
+            f"endpoints of each lie within {p.max_distance:g} m of the other line, do their "
+            "projections onto each other overlap? Then run the cell that prints their similarity."
+        )
     failed = ", ".join(f"({c})" for c in sorted(fails))
     verdict = f"fails {failed}: not similar" if fails else "no condition fails: similar"
     return f"{verdict}. " + "; ".join(why[c][1] for c in CONDITIONS) + "."

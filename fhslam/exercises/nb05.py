@@ -72,7 +72,9 @@ def check_corridor_pose(
     """Exercise 5.2 (predict): the pose ``(x, y, theta)`` (metres, radians) that
     :func:`fhslam.calibration.calibrate_pose` returns from the corridor's two parallel walls,
     starting from ``predicted``. Right within ``tolerance`` metres along and across the
-    corridor and ``heading_tolerance`` radians; the answer is computed here by the package."""
+    corridor and ``heading_tolerance`` radians; the answer is computed here by the package. A
+    wrong answer is told which of the three is off and what to ask of it, not the calibrated
+    pose (a prediction)."""
 
     @exercise("my_pose")
     def check(answer: Any) -> str:
@@ -94,26 +96,23 @@ def check_corridor_pose(
         along, across = abs(d @ along_dir), abs(d @ normal)
         turn = abs(wrap_angle(got[2] - pose[2]))
         moved_along = abs((pose[:2] - start[:2]) @ along_dir)
-        where = f"calibrated ({_fmt(pose[0], 2)}, {_fmt(pose[1], 2)}, {_fmt(pose[2], 3)})"
         if along > tolerance:
             raise Wrong(
-                f"along the corridor your pose is {100 * along:.0f} cm from the calibrated one: "
-                "parallel walls look the same from anywhere along them, so the lines say "
-                "nothing about that position and calibrate_pose keeps the odometry's there "
-                f"({where})"
+                f"along the corridor your pose is more than {100 * tolerance:g} cm from the "
+                "calibrated one: do two parallel walls say where along them the robot is? And "
+                "where the lines say nothing, what should a calibration do?"
             )
         if across > tolerance:
             raise Wrong(
-                f"across the corridor your pose is {100 * across:.0f} cm from the calibrated "
-                "one: the distances to the two walls fix the position across them, so the "
-                f"calibration corrects it ({where})"
+                f"across the corridor your pose is more than {100 * tolerance:g} cm from the "
+                "calibrated one: what do the distances to the two walls say?"
             )
         if turn > heading_tolerance:
             raise Wrong(
-                f"your heading {got[2]:.3f} rad is {turn:.3f} rad from the calibrated one: the "
-                "walls' direction fixes the heading, so the calibration corrects it (give it "
-                f"in radians; {where})"
+                f"your heading is more than {heading_tolerance:g} rad from the calibrated one: "
+                "what does the walls' direction say? (Give it in radians.)"
             )
+        where = f"calibrated ({_fmt(pose[0], 2)}, {_fmt(pose[1], 2)}, {_fmt(pose[2], 3)})"
         return (
             f"{where}: the heading and the position across the corridor corrected, the "
             f"odometry kept along it (moved {_fmt(100 * moved_along, 1)} cm along); "

@@ -59,7 +59,9 @@ def _cm(metres: float) -> str:
 def check_lowest_ate(answer: Any, rows: Sequence[RunResult], level: str = "high") -> Feedback:
     """Exercise 7.1 (predict): which method has the lowest median ATE rmse at ``level`` over
     the sweep ``rows``, a letter of :data:`METHOD_CHOICES`. The right letter is computed here
-    with :func:`fhslam.experiments.compare.summary`; every explanation gives the medians."""
+    with :func:`fhslam.experiments.compare.summary`; the right answer's explanation gives the
+    medians, a wrong one's what decides that method's accuracy, not the medians (a
+    prediction)."""
     s = summary(rows)
     medians = {m: s[(level, m)]["ate_median"] for m in METHOD_CHOICES.values() if (level, m) in s}
     best = min(medians, key=medians.__getitem__)
@@ -78,8 +80,7 @@ def check_lowest_ate(answer: Any, rows: Sequence[RunResult], level: str = "high"
             )
         else:
             why[letter] = (
-                f"{LABELS[m]}: its median ATE at {level} is {_cm(medians[m])}, the lowest is "
-                f"{LABELS[best]}'s (medians: {ranking}): {_WHY_METHOD[m]}"
+                f"{LABELS[m]} does not have the lowest median ATE at {level}: {_WHY_METHOD[m]}"
             )
     return check_choice(answer, right, why, what="my_prediction")
 
@@ -243,7 +244,8 @@ def check_classical_reading(answer: Any, rows: Sequence[RunResult]) -> Feedback:
     The readings (:data:`READINGS`) are decided in turn, so exactly one is right: (a) if the
     ratio of the medians (classical / FH-SLAM) is 2 or more at every level; else (c) if it is
     below 1 at most levels; else (b) if the ratio of the worst runs is 1.5 or more at every
-    level; else (d)."""
+    level; else (d). The right reading's explanation gives the medians and the worst runs; a
+    wrong one's is a hint (where to look and what to test there), without the numbers."""
     s = summary(rows)
     levels = [lv for lv in ("low", "medium", "high") if (lv, "fht") in s and (lv, "classical") in s]
     med = {lv: s[(lv, "classical")]["ate_median"] / s[(lv, "fht")]["ate_median"] for lv in levels}
@@ -289,24 +291,23 @@ def check_classical_reading(answer: Any, rows: Sequence[RunResult]) -> Feedback:
         "c": "in SLAM the precision claim is reversed.",
         "d": "in SLAM this sweep does not tell the two extractors apart.",
     }
-    n = len(levels)
-    # why a reading is wrong: the first of its conditions that the numbers break
-    if all_twice:
-        not_b = f"FH-SLAM's median is at least 2 times lower at every level: {medians}"
-    elif mostly_classical:
-        not_b = f"classical Hough's median is the lower at {len(classical_lower)} of {n} levels"
-        not_b += f": {medians}"
-    else:
-        not_b = ""
+    # a wrong reading gets a hint, not the numbers: where in the box plots and the table to
+    # look, and the test to make there. (b) and (d) differ only in the worst runs, so their hint
+    # names both of their parts, whichever one fails: naming it would settle the other reading.
+    look_medians = (
+        "compare the median lines (the table's ATE median) of FH-SLAM (paper) and FH-SLAM + "
+        "classical Hough at each level"
+    )
+    look_worst = (
+        "the worst runs (the table's ATE max, the highest point of each box plot) at each level"
+    )
+    both = f"check both of its parts: {look_medians}, then {look_worst}, as ratios"
+    both += " classical / FH-SLAM"
     wrong = {
-        "a": f"the medians are not 2 times apart at every level: {medians}",
-        "b": not_b or f"the worst runs are within a factor 1.5 at {', '.join(alike)}: {worsts}",
-        "c": not_b
-        if all_twice
-        else f"classical Hough's median is the lower at {len(classical_lower)} of {n} levels: "
-        f"{medians}",
-        "d": not_b
-        or f"classical Hough's worst run is at least 1.5 times FH-SLAM's at every level: {worsts}",
+        "a": f"{look_medians}: is classical Hough's at least 2 times FH-SLAM's at every level?",
+        "b": both,
+        "c": f"{look_medians}: at how many of the levels is classical Hough's the lower?",
+        "d": both,
     }
     facts = {"a": medians, "b": f"{medians}; {worsts}", "c": medians, "d": f"{medians}; {worsts}"}
     why = {}
@@ -314,5 +315,5 @@ def check_classical_reading(answer: Any, rows: Sequence[RunResult]) -> Feedback:
         if letter == right:
             why[letter] = f"{reading}: {facts[letter]} — {lesson[letter]}"
         else:
-            why[letter] = f"not so: {wrong[letter]}."
+            why[letter] = f"not so; {wrong[letter]}"
     return check_choice(answer, right, why, what="my_answer")

@@ -8,7 +8,11 @@ saying to run the cell, instead of ``interactive(children=(IntSlider(...``. Slid
 released (``continuous_update=False``); every redraw takes well under a second on a 2-core
 machine (each explorer's work is one scan, one pair of lines or one short run).
 
-Every explorer's first control changes its figure (the browser test moves it). Each
+Every control changes what its figure draws in one step from its default, up (down from the
+top), not only a number in a title: a threshold is drawn where it acts (a line across the
+quantity it is compared with, a band, a window, a box), the iterations by what each one does
+(the tests move every control and compare the figures with their texts blanked; the browser
+test moves each explorer's first). Each
 ``*_explorer`` function returns the :class:`Explorer`; ``explorer.set(name=value)`` moves
 a control from code (what the tests do) and ``explorer.figure()`` draws the current state.
 """
@@ -132,14 +136,68 @@ def _axes_labels(ax) -> None:
     ax.set_ylabel("y [m]")
 
 
+def _sqrt_scale(ax, top: float) -> None:
+    """A square-root y axis from 0 to ``top`` metres: centimetre gaps stand apart near the
+    bottom, and a threshold line still moves by a pixel or more at the top for a step of its
+    slider."""
+    ax.set_yscale("function", functions=(np.sqrt, np.square))
+    ax.set_ylim(0.0, top)
+    ticks = [t for t in (0.05, 0.1, 0.2, 0.5, 1.0, 2.0) if t < top]
+    ax.set_yticks([0.0, *ticks], ["0", *(f"{t:g}" for t in ticks)])
+
+
+def _gap_panel(
+    ax, pts, beams, labels, cluster_gap: float, top: float, densify_step: float | None = None
+) -> None:
+    """The distance between neighbouring scan points along the scan, each gap coloured as its
+    cluster (the scan panel's colours): above ``cluster_gap`` (shaded) a new cluster starts,
+    marked by a black cross. With ``densify_step``, a gap above it inside a cluster (shaded
+    lighter) gets points added every ``densify_step``. Gaps above ``top`` are drawn at it."""
+    cmap = plt.get_cmap("tab10")
+    gaps = np.hypot(*np.diff(pts, axis=0).T) if len(pts) > 1 else np.zeros(0)
+    at = 0.5 * (beams[1:] + beams[:-1])
+    shown = np.minimum(gaps, top)
+    split = gaps > cluster_gap
+    ax.axhspan(cluster_gap, top, color="0.85", zorder=0, label="new cluster above the gap")
+    ax.axhline(cluster_gap, color="k", lw=1.2, zorder=1)
+    if densify_step:
+        ax.axhspan(
+            min(densify_step, cluster_gap),
+            cluster_gap,
+            color="tab:green",
+            alpha=0.15,
+            lw=0,
+            zorder=0,
+            label="points added (densify)",
+        )
+        ax.axhline(densify_step, color="tab:green", lw=1.2, ls="--", zorder=1)
+    inside = ~split
+    ax.scatter(
+        at[inside], shown[inside], s=9, c=[cmap(lab % 10) for lab in labels[:-1][inside]], zorder=3
+    )
+    ax.scatter(at[split], shown[split], s=40, marker="x", c="k", zorder=4, clip_on=False)
+    _sqrt_scale(ax, top)
+    ax.set_xlim(beams[0] - 2 if len(beams) else 0, beams[-1] + 2 if len(beams) else 1)
+    ax.set_xlabel("beam (scan order)")
+    ax.set_ylabel("gap to the next point [m]")
+    ax.legend(loc="upper left", fontsize=7, framealpha=0.9)
+
+
 def clustering_explorer(log: Log, k: int, min_points: int = ExtractionParams().min_points):
-    """Notebook 02: the clusters of scan ``k`` as the gap between neighbours changes."""
+    """Notebook 02: the clusters of scan ``k`` as the gap between neighbours changes.
+
+    Left: the scan's points coloured by cluster. Right: the gap from each point to the next,
+    along the scan, with the slider's gap drawn across it: every gap above it (shaded) starts a
+    new cluster (black crosses)."""
 
     def draw(cluster_gap: float, scan: int) -> Figure:
-        pts, _ = log.scan(scan).points()
+        pts, beams = log.scan(scan).points()
         labels = cluster_scan(pts, cluster_gap)
         sizes = np.bincount(labels) if len(labels) else np.zeros(0, int)
-        fig, ax = plt.subplots(figsize=FIGSIZE)
+        fig, (ax, gap_ax) = plt.subplots(
+            1, 2, figsize=(11.5, 4.5), gridspec_kw={"width_ratios": [1.3, 1]}
+        )
+        fig.subplots_adjust(left=0.06, right=0.98, bottom=0.12, top=0.92, wspace=0.22)
         plotting.plot_clusters(pts, labels, ax=ax)
         ax.plot(0, 0, "k^", ms=9, label="robot")
         _axes_labels(ax)
@@ -147,6 +205,8 @@ def clustering_explorer(log: Log, k: int, min_points: int = ExtractionParams().m
             f"scan {scan}, gap {cluster_gap:.2f} m: {len(sizes)} clusters, "
             f"{int((sizes >= min_points).sum())} with ≥ {min_points} points"
         )
+        _gap_panel(gap_ax, pts, beams, labels, cluster_gap, top=2.2)
+        gap_ax.set_title(f"{int((np.diff(labels) > 0).sum())} gaps above {cluster_gap:.2f} m")
         return fig
 
     return Explorer(
@@ -159,15 +219,99 @@ def clustering_explorer(log: Log, k: int, min_points: int = ExtractionParams().m
     )
 
 
+def _window_panel(ax, pts, p: ExtractionParams) -> None:
+    """Step 2's window on step 1's histogram: the directions of the point pairs of each cluster
+    (of at least ``p.min_points`` points, densified) relative to the cluster's dominant
+    direction, summed over the clusters (the first line of each; the next ones are sought on
+    the points left), with the window of ±``p.window_deg`` shaded and the directions the Hough
+    vote tries (every ``p.theta_step_deg``) ticked under it."""
+    from fhslam.extraction import densify, dominant_angle, lone_points, slope_histogram
+
+    if p.drop_lone_points and len(pts) > 2:
+        pts = pts[~lone_points(pts, p.cluster_gap)]
+    labels = cluster_scan(pts, p.cluster_gap)
+    n_bins = round(180.0 / p.angle_bin_deg)
+    rel = np.zeros(n_bins)
+    if len(pts):
+        dense, dense_labels, _ = densify(pts, labels, p.densify_step)
+        hist = slope_histogram(dense, dense_labels, p)
+        phi, _ = dominant_angle(hist)
+        big = np.bincount(labels) >= p.min_points
+        for h, f in zip(hist[big], phi[big], strict=True):
+            rel += np.roll(h, n_bins // 2 - int(f / np.radians(p.angle_bin_deg)))
+    offsets = (np.arange(n_bins) - n_bins // 2) * p.angle_bin_deg
+    ax.axvspan(-p.window_deg, p.window_deg, color="tab:blue", alpha=0.15, lw=0, label="window")
+    edges = np.r_[offsets, offsets[-1] + p.angle_bin_deg] - 0.5 * p.angle_bin_deg
+    ax.stairs(rel, edges, fill=True, color="0.35", label="point pairs")  # one artist: fast
+    half = round(p.window_deg / p.theta_step_deg)
+    tried = np.arange(-half, half + 1) * p.theta_step_deg
+    ax.plot(
+        tried,
+        np.zeros_like(tried),
+        "|",
+        color="tab:blue",
+        ms=10,
+        mew=1.5,
+        clip_on=False,
+        label="directions voted",
+    )
+    ax.set_xlim(-30, 30)
+    ax.set_ylim(0, max(1.0, 1.08 * rel.max()))
+    ax.set_xlabel("pair direction − the cluster's dominant one [°]")
+    ax.set_ylabel("pairs")
+    ax.legend(loc="upper left", fontsize=7, framealpha=0.9)
+
+
+def _support_panel(ax, pts, beams, found, inlier_dist: float, top: float) -> None:
+    """Each scan point's distance to the nearest line found, along the scan, with the inlier
+    distance shaded: the points of a line (its support, red) lie within it, the others are
+    grey. Distances above ``top`` are drawn at it."""
+    d = np.full(len(pts), np.inf)
+    for line in found:
+        a, b = np.asarray(line.sp), np.asarray(line.ep)
+        u = b - a
+        t = np.clip(((pts - a) @ u) / max(float(u @ u), 1e-12), 0.0, 1.0)
+        d = np.minimum(d, np.hypot(*(pts - a - t[:, None] * u).T))
+    support = np.zeros(len(pts), bool)
+    for line in found:
+        support[line.inliers] = True
+    shown = np.minimum(d, top)
+    ax.axhspan(0.0, inlier_dist, color=plotting.LINE_COLOR, alpha=0.12, lw=0, label="inlier band")
+    ax.axhline(inlier_dist, color=plotting.LINE_COLOR, lw=1.2)
+    ax.scatter(beams[~support], shown[~support], s=9, c="0.55", zorder=3, clip_on=False)
+    ax.scatter(
+        beams[support],
+        shown[support],
+        s=9,
+        c=plotting.LINE_COLOR,
+        zorder=3,
+        clip_on=False,
+        label="supports a line",
+    )
+    ax.set_ylim(0.0, top)
+    ax.set_xlim(beams[0] - 2 if len(beams) else 0, beams[-1] + 2 if len(beams) else 1)
+    ax.set_xlabel("beam (scan order)")
+    ax.set_ylabel("to the nearest line [m]")
+    ax.legend(loc="upper left", fontsize=7, framealpha=0.9)
+
+
 def extraction_explorer(log: Log, k: int):
     """Notebook 03: the lines of scan ``k`` under the extraction's thresholds, the support
     threshold first (the paper's "until the number to support a certain slope is lower than
-    the threshold"). Each line is marked with its number and its support (scan points); the
-    title gives the count of lines and the thresholds."""
+    the threshold"). Left: the lines, each marked with its number and its support (scan
+    points), on the clusters and the points densification adds (grey dots; they only vote);
+    the title gives the count of lines and the thresholds.
+
+    Right, each other threshold drawn where it acts: the gaps between neighbouring points with
+    the cluster gap and the densify step (:func:`_gap_panel`); the pair directions of each
+    cluster around its dominant one, with the Hough window (:func:`_window_panel`); and each
+    point's distance to the nearest line, with the inlier distance (:func:`_support_panel`)."""
+    from fhslam.extraction import densify
+
     d = ExtractionParams()
 
     def draw(min_points, window_deg, inlier_dist, cluster_gap, densify_step, scan) -> Figure:
-        pts, _ = log.scan(scan).points()
+        pts, beams = log.scan(scan).points()
         p = ExtractionParams(
             cluster_gap=cluster_gap,
             window_deg=window_deg,
@@ -176,8 +320,19 @@ def extraction_explorer(log: Log, k: int):
             densify_step=densify_step,
         )
         found = extract_lines(pts, p)
-        fig, ax = plt.subplots(figsize=FIGSIZE)
-        plotting.plot_clusters(pts, cluster_scan(pts, cluster_gap), ax=ax)
+        labels = cluster_scan(pts, cluster_gap)
+        fig = plt.figure(figsize=(13, 7.5))
+        grid = fig.add_gridspec(
+            3, 2, width_ratios=[1.35, 1], left=0.05, right=0.98, bottom=0.07, top=0.92
+        )
+        grid.update(wspace=0.18, hspace=0.55)
+        ax = fig.add_subplot(grid[:, 0])
+        gap_ax, window_ax, support_ax = (fig.add_subplot(grid[i, 1]) for i in range(3))
+        plotting.plot_clusters(pts, labels, ax=ax)
+        if densify_step > 0 and len(pts):
+            dense, _, source = densify(pts, labels, densify_step)
+            added = dense[source < 0]
+            ax.scatter(*added.T, s=2, c="0.45", zorder=2, lw=0)
         plotting.plot_lines(found, ax=ax)
         for i, line in enumerate(found, 1):
             ax.annotate(
@@ -196,6 +351,12 @@ def extraction_explorer(log: Log, k: int):
             f"gap {cluster_gap:.2f} m, densify {densify_step:.2f} m",
             fontsize=10,
         )
+        _gap_panel(gap_ax, pts, beams, labels, cluster_gap, top=1.6, densify_step=densify_step)
+        gap_ax.set_title("clustering and densification", fontsize=10)
+        _window_panel(window_ax, pts, p)
+        window_ax.set_title("the Hough window on the slope histogram", fontsize=10)
+        _support_panel(support_ax, pts, beams, found, inlier_dist, top=0.16)
+        support_ax.set_title("the support of the lines", fontsize=10)
         return fig
 
     return Explorer(
@@ -218,7 +379,12 @@ def similarity_explorer():
     """Notebook 04: the four similarity conditions of a reference line (Fig. 7's) and a new
     line that the sliders turn about its middle (the first slider: each 1° step changes the
     angle in the title), move across and slide along, under thresholds the sliders set; the
-    robot stands at :data:`~fhslam.figures.scenes.SIMILARITY_POSE`, below the reference."""
+    robot stands at :data:`~fhslam.figures.scenes.SIMILARITY_POSE`, below the reference.
+
+    Each threshold is drawn where it acts: (c)'s as a band either side of the reference, in
+    which the new line's endpoints must lie, and (b)'s as a wedge through the new line's middle,
+    the reference's direction turned by up to the threshold either way, in which the new line
+    must lie."""
     from fhslam.figures.scenes import SIMILARITY_POSE, similarity_examples
     from fhslam.geometry import compose
     from fhslam.lines import transform_lines
@@ -246,6 +412,22 @@ def similarity_explorer():
             color="0.9",
             zorder=1,
             label=f"(c) band ±{max_distance:.2f} m",
+        )
+        # (b)'s wedge: the directions within the threshold of the reference's (horizontal),
+        # through the new line's middle; the new line lies in it when (b) holds
+        centre = np.asarray(compose(moved, (mid[0], mid[1], 0.0))[:2])
+        a = np.radians(max_angle_deg)
+        up, down = np.array([np.cos(a), np.sin(a)]), np.array([np.cos(a), -np.sin(a)])
+        reach = 12.0  # beyond the axes either way: the wedge is cut at their edges
+        corners = [centre + reach * up, centre + reach * down, centre]
+        corners += [centre - reach * up, centre - reach * down, centre]
+        ax.fill(
+            *np.array(corners).T,
+            color="tab:blue",
+            alpha=0.12,
+            lw=0,
+            zorder=1,
+            label=f"(b) wedge ±{max_angle_deg:g}°",
         )
         plotting.plot_lines([ref], ax=ax, color="0.5", linewidth=5, label="reference")
         color = "tab:green" if s.similar else "tab:red"
@@ -275,7 +457,8 @@ def similarity_explorer():
             "offset": slider(0.0, -1.5, 1.0, 0.02, "move it across [m]"),
             "slide": slider(0.0, -3.5, 3.5, 0.1, "slide it along [m]"),
             "max_angle_deg": slider(d.max_angle_deg, 0.5, 30.0, 0.5, "threshold (b): angle [°]"),
-            "max_distance": slider(d.max_distance, 0.01, 1.0, 0.01, "threshold (c): distance [m]"),
+            # 5 cm steps: the band's edges move by a few pixels (1 cm would be under one)
+            "max_distance": slider(d.max_distance, 0.05, 1.0, 0.05, "threshold (c): distance [m]"),
         },
         "Similarity: move the new line and the thresholds",
     )
@@ -288,13 +471,17 @@ def calibration_explorer(log: Log, k: int):
     The sliders set the odometry's error in the robot's frame (forward, left, heading), the
     similarity thresholds (c) and (b) that decide which new lines are matched, and the
     Gauss-Newton rounds. Left: the new lines at the predicted pose, matched ones solid,
-    unmatched dashed; right: at the calibrated pose. The dashed triangle is the true pose."""
+    unmatched dashed; middle: at the calibrated pose. The dashed triangle is the true pose.
+    Right: what the rounds minimise, the rms distance of the matched lines' endpoints to their
+    reference lines, after each round up to the slider's top, those applied solid and the
+    others dotted: where it no longer falls, another round changes nothing."""
     from matplotlib.lines import Line2D
+    from matplotlib.patches import Rectangle
 
     from fhslam.calibration import calibrate_pose
     from fhslam.geometry import compose, wrap_angle
     from fhslam.lines import transform_lines
-    from fhslam.matching import MatchParams, match_lines
+    from fhslam.matching import MatchParams, match_lines, similarity_matrix
 
     truth = log.truth[k]
     points, _ = log.scan(k).points()
@@ -314,13 +501,115 @@ def calibration_explorer(log: Log, k: int):
             xy = np.array([[q.sp, q.ep, (np.nan, np.nan)] for q in lines]).reshape(-1, 2)
             ax.plot(*xy.T, solid_capstyle="round", **kw)
 
+    rounds = 6  # the iterations slider's top
+    floor = 1e-9  # mm: below it, floating-point rounding
+
+    def residual(pose, pairs) -> float:
+        """The rms distance (m) of the matched lines' endpoints, placed at ``pose``, to their
+        reference lines: what the Gauss-Newton rounds minimise."""
+        placed = transform_lines([observed[i] for i, _ in pairs], pose)
+        d = [
+            references[j].rho - x * np.cos(references[j].theta) - y * np.sin(references[j].theta)
+            for q, (_, j) in zip(placed, pairs, strict=True)
+            for x, y in (q.sp, q.ep)
+        ]
+        return float(np.sqrt(np.mean(np.square(d))))
+
+    def convergence(ax, predicted, pairs, iterations) -> None:
+        each = np.arange(rounds + 1)
+        if pairs:
+            poses = [
+                calibrate_pose(observed, references, pairs, predicted, iterations=n).pose
+                for n in each
+            ]
+            mm = np.maximum([1000 * residual(p, pairs) for p in poses], floor)
+            n, done = iterations, f"{iterations} round{'s' if iterations != 1 else ''} applied"
+            ax.plot(each[n:], mm[n:], ":o", c="0.55", mfc="w", label="more rounds")
+            ax.plot(each[: n + 1], mm[: n + 1], "-o", c="tab:red", label=done)
+            ax.legend(loc="upper right", fontsize=8)
+        else:
+            ax.text(
+                0.5,
+                0.5,
+                "no line matched:\nnothing to minimise",
+                ha="center",
+                va="center",
+                transform=ax.transAxes,
+            )
+        ax.set_yscale("log")
+        ax.set_ylim(floor / 10, 1e4)
+        ax.axhspan(floor / 10, floor, color="0.92", zorder=0)
+        ax.text(rounds, floor / 3, "rounding", ha="right", va="center", fontsize=8, color="0.4")
+        ax.set_xticks(each)
+        ax.set_xlim(-0.4, rounds + 0.4)
+        ax.set_xlabel("Gauss-Newton round")
+        ax.set_ylabel("rms endpoint distance [mm]")
+        ax.set_title("matched endpoints to their lines", fontsize=10)
+
+    angle_top, gate_top = 21.0, 1.6  # just above the sliders' tops
+
+    def thresholds(ax, placed, params, predicted, match) -> None:
+        """Thresholds (b) and (c) where they act: each new line at the predicted pose as a
+        point, its angle to a reference line across, its endpoint distance (the largest of
+        the four) up; the box of the two thresholds shaded. A line is matched inside the box:
+        to the reference it is matched to, else the nearest one seen from the same side and
+        overlapping it ((a) and (d), which the sliders do not set)."""
+        m = similarity_matrix(placed, references, params, predicted)
+        cost = np.where(
+            m["same_direction"] & m["overlap_ok"], m["distance"] + 0.01 * m["angle_deg"], np.inf
+        )
+        ax.add_patch(
+            Rectangle(
+                (0, 0),
+                params.max_angle_deg,
+                params.max_distance,
+                facecolor="tab:blue",
+                alpha=0.15,
+                edgecolor="none",
+                label="(b) and (c) hold",
+            )
+        )
+        ax.plot(
+            [0, params.max_angle_deg, params.max_angle_deg],
+            [params.max_distance, params.max_distance, 0],
+            color="tab:blue",
+            lw=1.2,
+        )
+        for i in range(len(placed)):
+            j = match[i] if match[i] >= 0 else int(cost[i].argmin())
+            if not np.isfinite(cost[i, j]):
+                continue  # no reference seen from the same side and overlapping
+            xy = min(m["angle_deg"][i, j], angle_top), min(m["distance"][i, j], gate_top)
+            ok = match[i] >= 0
+            ax.plot(
+                *xy,
+                "o",
+                ms=6,
+                mfc="tab:red" if ok else "none",
+                mec="tab:red" if ok else "tab:orange",
+                mew=1.5,
+                clip_on=False,
+                zorder=4,
+            )
+        ax.set_xlim(0, angle_top)
+        ax.set_ylim(0, gate_top)
+        ax.set_xlabel("(b) angle to the reference line [°]")
+        ax.set_ylabel("(c) endpoint distance [m]")
+        ax.set_title("matched inside the thresholds' box", fontsize=10)
+
     def draw(dx_cm, dy_cm, dtheta_deg, gate, max_angle_deg, iterations) -> Figure:
         predicted = compose(truth, (dx_cm / 100, dy_cm / 100, np.radians(dtheta_deg)))
         params = MatchParams(max_distance=gate, max_angle_deg=max_angle_deg)
-        match = match_lines(transform_lines(observed, predicted), references, params, predicted)
+        at_predicted = transform_lines(observed, predicted)
+        match = match_lines(at_predicted, references, params, predicted)
         pairs = [(i, int(j)) for i, j in enumerate(match) if j >= 0]
         cal = calibrate_pose(observed, references, pairs, predicted, iterations=iterations)
-        fig, axes = plt.subplots(1, 2, figsize=(10, 5.2))
+        fig = plt.figure(figsize=(13, 6))
+        grid = fig.add_gridspec(2, 3, width_ratios=[1, 1, 0.8], hspace=0.5, wspace=0.28)
+        axes = [fig.add_subplot(grid[:, 0]), fig.add_subplot(grid[:, 1])]
+        axes += [fig.add_subplot(grid[1, 2]), fig.add_subplot(grid[0, 2])]
+        convergence(axes[2], predicted, pairs, iterations)
+        thresholds(axes[3], at_predicted, params, predicted, match)
         ends = [np.array([[r.sp, r.ep] for r in references]).reshape(-1, 2)]
         for ax, p, name in ((axes[0], predicted, "predicted"), (axes[1], cal.pose, "calibrated")):
             placed = transform_lines(observed, p)
@@ -337,13 +626,13 @@ def calibration_explorer(log: Log, k: int):
             ax.set_title(f"{name}: {err:.1f} cm, {dth:+.2f}° off")
             ax.set_xlabel("x [m] (world)")
         lo, hi = np.vstack(ends).min(axis=0) - 0.5, np.vstack(ends).max(axis=0) + 0.5
-        for ax in axes:  # the same window on both sides, to see what moved
+        for ax in axes[:2]:  # the same window on both sides, to see what moved
             ax.set_aspect("equal", adjustable="box")
             ax.set_xlim(lo[0], hi[0])
             ax.set_ylim(lo[1], hi[1])
         axes[0].set_ylabel("y [m] (world)")
         fig.legend(handles=legend, loc="lower center", ncol=5, fontsize=9, frameon=False)
-        fig.subplots_adjust(left=0.07, right=0.98, bottom=0.2, top=0.8, wspace=0.2)
+        fig.subplots_adjust(left=0.06, right=0.98, bottom=0.16, top=0.85)
         fixed = {
             (True, True): "the position in both directions",
             (False, True): "the position in one direction only (the other is kept)",
@@ -366,7 +655,7 @@ def calibration_explorer(log: Log, k: int):
             "dtheta_deg": slider(3.0, -10.0, 10.0, 0.5, "odometry error heading [°]"),
             "gate": slider(0.6, 0.05, 1.5, 0.05, "threshold (c): distance gate [m]"),
             "max_angle_deg": slider(d.max_angle_deg, 1.0, 20.0, 0.5, "threshold (b): angle [°]"),
-            "iterations": slider(3, 0, 6, 1, "Gauss-Newton iterations"),
+            "iterations": slider(3, 0, rounds, 1, "Gauss-Newton iterations"),
         },
         "Self-calibration: put the pose wrong, see it corrected",
     )

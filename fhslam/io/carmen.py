@@ -13,7 +13,9 @@ not text -- holding NUL bytes or bytes that are not UTF-8, or longer than :data:
 and the lines after it are read: one :class:`CarmenWarning` names the file, the line and
 byte where the first such line starts, how many bytes were skipped and up to where. A file
 without a laser message that has such lines is not a CARMEN text log (a
-:class:`CarmenFormatError`, which says so for a gzip-compressed file: decompress it first).
+:class:`CarmenFormatError`). A gzip-compressed log (``fr101.carmen.log.gz``) is read as it
+is, decompressed as a stream; damaged compressed data is a :class:`CarmenFormatError` naming
+the file.
 
 Write: one ``ODOM`` and one ``FLASER`` line per scan, every number as Python's shortest
 round-trip ``repr``, so reading the file back gives exactly the same floats. The odometry
@@ -58,7 +60,7 @@ the tolerance), the ``PARAM`` values win and a :class:`CarmenWarning` names the 
 both values. The ``PARAM`` lines are the mount the robot was configured with, from which
 CARMEN's robot module computed the laser poses; laser poses that disagree were written by
 another program, and programs that rewrite CARMEN logs may copy the odometry into both
-triples (fhslam's own writer did, before issue 10): a zero offset that states nothing.
+triples: a zero offset that states nothing.
 ``Log.laser_offset_source`` records the outcome: ``"PARAM"``, ``"laser pose"`` or
 ``"none"``.
 
@@ -95,13 +97,16 @@ is a :class:`CarmenFormatError`; every other ``PARAM`` (many hold strings) is ig
 from __future__ import annotations
 
 import codecs
+import gzip
 import io
 import math
 import warnings
+import zlib
 from collections.abc import Iterator
 from dataclasses import dataclass, field
 from os import PathLike
 from pathlib import Path
+from typing import IO
 
 import numpy as np
 from numpy.typing import NDArray
@@ -597,15 +602,48 @@ class _Unreadable:
         return f"{self.nbytes} bytes that are not text ({why}) {where}"
 
 
+class _Gunzipped(gzip.GzipFile):
+    """A gzip-compressed file read as its text: damaged or cut compressed data is a
+    :class:`CarmenFormatError` naming the file and how far it was read."""
+
+    def __init__(self, raw: IO[bytes], path: Path) -> None:
+        super().__init__(fileobj=raw, mode="rb")
+        self._path, self._raw = path, raw
+
+    def read(self, size: int = -1) -> bytes:
+        try:
+            return super().read(size)
+        except (EOFError, OSError, zlib.error) as e:
+            where = self._raw.tell()
+            raise CarmenFormatError(
+                f"{self._path}: damaged gzip data at about byte {where} of the compressed "
+                f"file ({e}); the log cannot be read past it"
+            ) from None
+
+    def read1(self, size: int = -1) -> bytes:
+        try:
+            return super().read1(size)
+        except (EOFError, OSError, zlib.error) as e:
+            where = self._raw.tell()
+            raise CarmenFormatError(
+                f"{self._path}: damaged gzip data at about byte {where} of the compressed "
+                f"file ({e}); the log cannot be read past it"
+            ) from None
+
+
 def _text_lines(path: Path, junk: _Unreadable) -> Iterator[tuple[int, str]]:
     """The lines of the file ``path`` that are text, as ``(line number, line)``: decoded as
-    UTF-8, a byte-order mark at the start skipped, any line break (``\\n``, ``\\r\\n``,
-    ``\\r``) ending a line, as a text file is read. A line holding NUL bytes or bytes that are
+    UTF-8 (after gzip's decompression where the file starts with its magic bytes; byte
+    offsets are then those of the decompressed text), a byte-order mark at the start
+    skipped, any line break (``\\n``, ``\\r\\n``, ``\\r``) ending a line, as a text file
+    is read. A line holding NUL bytes or bytes that are
     not UTF-8, or longer than :data:`MAX_LINE`, is not yielded but recorded in ``junk``. The
     file is read in pieces of at most :data:`MAX_LINE` characters."""
-    with path.open("rb") as f:
+    with path.open("rb") as raw:
+        junk.gzip = raw.read(2) == b"\x1f\x8b"
+        raw.seek(0)
+        f = _Gunzipped(raw, path) if junk.gzip else raw
         head = f.read(3)
-        junk.gzip = head[:2] == b"\x1f\x8b"
         offset = 3 if head == codecs.BOM_UTF8 else 0
         f.seek(offset)
         text = io.TextIOWrapper(f, encoding="utf-8", errors="surrogateescape", newline="")
@@ -644,7 +682,7 @@ def read_carmen(path: str | PathLike[str], max_range: float | None = None) -> Lo
     Parameters
     ----------
     path : str or path-like
-        The ``.clf``/``.log`` file (UTF-8 text; not compressed).
+        The ``.clf``/``.log`` file (UTF-8 text), or the same compressed with gzip.
     max_range : float, optional
         The laser's maximum range in metres (readings at or beyond it mean "no return").
         Default: the log's "no return" code (:func:`fhslam.io.log.no_return_reading`, e.g.
@@ -744,7 +782,7 @@ def read_carmen(path: str | PathLike[str], max_range: float | None = None) -> Lo
             laser_poses.append(laser_pose)
     if first is None:
         if junk.lines:
-            gz = "gzip-compressed (decompress it first, e.g. gunzip); " if junk.gzip else ""
+            gz = "gzip-compressed, and its text " if junk.gzip else ""
             raise CarmenFormatError(
                 f"{path}: not a CARMEN text log: {gz}{junk.describe()}, and no FLASER or "
                 "ROBOTLASER1 laser messages"

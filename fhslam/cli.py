@@ -1,4 +1,4 @@
-"""The ``fhslam`` command (the contract is in DESIGN.md).
+"""The ``fhslam`` command, and its contract with the user.
 
 Bad input — a missing or malformed file, an unknown world — ends with one line on stderr,
 ``fhslam: error: <file>:<line>: <what>``, and exit status 2; never a traceback. Every command
@@ -945,7 +945,7 @@ def build_parser() -> argparse.ArgumentParser:
         "0..N-1 (--range-noise, --drop-scans, --clutter; or --last-bit-draws), each measured "
         "against the log's benchmark relations, and count the runs whose relation error "
         "moved by more than 25 % or 1 cm (whichever is larger) from the run on the log as "
-        "read: issue 10's robustness bound.",
+        "read: the robustness bound.",
     )
     p.add_argument("--world", help="world to simulate (default paper)")
     p.add_argument(

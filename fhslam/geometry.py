@@ -1,6 +1,6 @@
 """Planar geometry: SE(2) poses, angle wrapping, points and lines in Hessian normal form.
 
-Conventions (see DESIGN.md): metres and radians; a pose is ``(x, y, theta)`` and maps the
+Conventions: metres and radians; a pose is ``(x, y, theta)`` and maps the
 robot frame into the world frame (``world_T_robot``); angles are wrapped to (-pi, pi]; a
 line is ``rho = x cos(theta) + y sin(theta)`` (paper eq. (1)) with ``rho >= 0`` and
 ``theta`` in [0, 2 pi).

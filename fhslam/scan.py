@@ -3,7 +3,7 @@
 A scan is what the laser reports at one instant: a range per beam and the beams' bearings in
 the laser frame (counter-clockwise from straight ahead, radians). A beam without a return
 (its range NaN, infinite, not positive, or at or beyond the laser's maximum range) is
-*dropped* by :func:`scan_to_points`, never turned into a point (DESIGN.md, conventions).
+*dropped* by :func:`scan_to_points`, never turned into a point.
 """
 
 from __future__ import annotations

@@ -240,7 +240,7 @@ def _smooth_windows_numpy(p, nrm, h, cos):
 def _smooth_windows(p, nrm, h, cos):  # pragma: no cover
     """For :func:`smooth_scan`, each window of ``2 h + 1`` points: its mean, whether its
     normals pass the turn tests, and the rms of its points across the middle normal (0.31
-    ms a scan in NumPy, 0.08 ms in all compiled; stop 43); the operations of
+    ms a scan in NumPy, 0.08 ms in all compiled); the operations of
     :func:`_smooth_windows_numpy` in its order (sums from +0.0, one term after
     the other, as NumPy sums fewer than 8 values; NaN normals fail the tests, and count
     as 0 across)."""

@@ -626,6 +626,6 @@ timing_table(
 #   keyframe graph to files, which a notebook, `fhslam evaluate` or a test can read.
 # - All five shared logs (these two, aces, fr079, fr-clinic) were used in development; logs
 #   nobody here has seen are the real test of the defaults. The README has all five: all meet
-#   issue 10's limits as logged (the Freiburg hospital's return to its start, 900 m after its
+#   their relation-error limits as logged (the Freiburg hospital's return to its start, 900 m after its
 #   last loop closure, only through a global loop search), but the hospital not with 1 mm of
 #   range noise or dropped scans.

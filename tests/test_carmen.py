@@ -299,7 +299,7 @@ def _flaser_log(rows: list[list[float]]) -> str:
 def test_no_return_code_below_noisy_long_returns_is_found(tmp_path):
     """A log whose no-return code (50.0 m) is exceeded by a few noisy real readings: the
     code, not the largest reading, is the maximum range, so no-return beams give no points
-    (before issue 9: max range 50.3 m and a phantom arc of points at 50 m)."""
+    (not a max range of 50.3 m and a phantom arc of points at 50 m)."""
     rng = np.random.default_rng(0)
     rows = []
     for k in range(400):
@@ -643,7 +643,7 @@ def _flaser(t: float, x: float) -> str:
 @pytest.mark.parametrize(
     ("times", "xs", "message"),
     [
-        # issue 13: read silently before, one demonstrably corrupting the evaluation
+        # each is warned of, not read silently: one demonstrably corrupts the evaluation
         (
             [0.0, 0.2, 0.1, 0.3],
             [0, 0.1, 0.2, 0.3],
@@ -662,7 +662,7 @@ def _flaser(t: float, x: float) -> str:
             r"t\.clf:3: the odometry jumps more than 10 m "
             r"from the scan on line 2 \(1e\+06 m\) \(and at 1 more scan\)",
         ),
-        # issue 13: a leap forward was read silently (the odometry's timestamps lie)
+        # a leap forward is warned of too (the odometry's timestamps lie)
         (
             [0.0, 0.2, 1e9, 1e9 + 0.2],
             [0, 0.1, 0.2, 0.3],
@@ -695,8 +695,8 @@ def test_a_plausible_log_reads_without_warnings(tmp_path):
 
 @pytest.mark.parametrize("value", ["nan", "inf", "-1.5", "1e308", "5000"])
 def test_readings_no_laser_gives_are_no_returns_with_a_warning(tmp_path, value):
-    """Issue 13: a 1e308 reading made the maximum range 1e308 m and the reading a point
-    1e308 m away; NaN, inf and negative readings were dropped without a word."""
+    """A 1e308 reading must not make the maximum range 1e308 m and the reading a point
+    1e308 m away, nor may NaN, inf and negative readings be dropped without a word."""
     rows = [[2.0, 2.1, 2.2, 2.3, 2.4 + 0.1 * k] for k in range(3)]
     path = tmp_path / "t.clf"
     path.write_text(_flaser_log(rows).replace("2.2 2.3", f"2.2 {value}", 1))
@@ -749,9 +749,9 @@ def _robotlaser1_head(start="-1.5707963", res="0.7853982", max_range="20.0") -> 
          "res-negative", "res-100-rad", "res-over-a-turn", "start-in-degrees"],
 )  # fmt: skip
 def test_a_robotlaser1_header_no_laser_states_is_an_error(tmp_path, fields, message):
-    """Issue 13: a maximum_range of 0 or -5 ended in a traceback (Log.max_range must be
-    positive); a resolution of 0, -1° or 100 rad per beam was read silently (the FLASER
-    PARAM lines' "more than 360 degrees" did not cover ROBOTLASER1)."""
+    """A maximum_range of 0 or -5 (Log.max_range must be positive) and a resolution of 0,
+    -1° or 100 rad per beam are errors with a line number, not a traceback or silence (the
+    FLASER PARAM lines' "more than 360 degrees" check covers ROBOTLASER1 as well)."""
     path = tmp_path / "rl.clf"
     good = robotlaser1([2, 3, 4, 5, 6], None, [1.5, 2.0, 0.5], 2.0)
     path.write_text(f"{good}\n{_robotlaser1_head(**fields)}\n")
@@ -760,8 +760,8 @@ def test_a_robotlaser1_header_no_laser_states_is_an_error(tmp_path, fields, mess
 
 
 def test_a_reading_repeated_far_below_the_stated_range_is_no_code(tmp_path):
-    """Issue 13: a ROBOTLASER1 log stating 20 m whose scans repeat exactly took the 2.0 m
-    ahead for the no-return code and dropped every reading from 2 m on. A code is sought in
+    """A ROBOTLASER1 log stating 20 m whose scans repeat exactly must not take the 2.0 m
+    ahead for the no-return code and drop every reading from 2 m on. A code is sought in
     the upper half of the stated range only; and the readings alone give none either: the
     scans repeat (a robot standing still), so they count as one scan, in which no value is
     read often enough."""
@@ -820,7 +820,7 @@ def _count_turns(text: str, turns: float) -> str:
 @pytest.mark.parametrize("turns", [1, -1, 3])
 def test_log_headings_counting_turns_are_wrapped_on_reading(tmp_path, turns):
     """A log whose headings count the turns (theta + 2 pi k) reads as the same log: every
-    odometry heading in (-pi, pi] (the convention of DESIGN.md), equal to the plain log's."""
+    odometry heading in (-pi, pi] (the convention of fhslam.geometry), equal to the plain log's."""
     log = simulate(paper_world(), seed=0)  # the whole drive: headings all round the circle
     plain_path = tmp_path / "plain.clf"
     write_carmen(log, plain_path)

@@ -680,8 +680,8 @@ def test_an_output_that_cannot_be_written_is_one_line_and_leaves_nothing(tmp_pat
 
 @pytest.mark.parametrize("which", ["world", "log", "outputs"])
 def test_an_output_never_overwrites_an_input(tmp_path, which):
-    # issue 13: `simulate W.json --log W.json` overwrote the world, `slam X.clf --trajectory
-    # X.clf` the log; refused now before anything is read or written
+    # `simulate W.json --log W.json` would overwrite the world, `slam X.clf --trajectory
+    # X.clf` the log: refused before anything is read or written
     world = tmp_path / "box.json"
     world.write_text(
         json.dumps({"name": "box", "walls": [[0, 0, 6, 0], [6, 0, 6, 4], [6, 4, 0, 4],
@@ -721,7 +721,7 @@ def test_an_implausible_log_warns_in_one_line_and_goes_on(tmp_path):
 @pytest.mark.parametrize(
     ("options", "message"),
     [
-        # issue 13: each was a traceback from deep inside the simulator or NumPy
+        # each a one-line error, not a traceback from deep inside the simulator or NumPy
         (["--seed", "-1"], "--seed must be a non-negative integer, got -1"),
         (["--laps", "0"], "--laps must be between 1 and 100, got 0"),
         (["--laps", "100000"], "--laps must be between 1 and 100, got 100000"),
@@ -750,8 +750,8 @@ def usage_error(argv: list[str], capsys) -> str:
 @pytest.mark.parametrize(
     ("option", "value", "message"),
     [
-        # issue 13: each was a ValueError traceback from metrics/trajectory.py, or (inf)
-        # accepted without a word
+        # each a one-line error, not a ValueError traceback from metrics/trajectory.py or
+        # (inf) accepted without a word
         ("--delta", "0", "argument --delta: must be a whole number >= 1, got 0"),
         ("--delta", "-3", "argument --delta: must be a whole number >= 1, got -3"),
         ("--delta", "2.5", "argument --delta: not a whole number: '2.5'"),
@@ -783,7 +783,7 @@ def test_evaluate_delta_beyond_the_matched_poses_is_one_line(truth_file, capsys)
 @pytest.mark.parametrize(
     ("argv", "message"),
     [
-        # issue 13: `ValueError: Maximum allowed size exceeded` from np.linspace
+        # a one-line error, not `ValueError: Maximum allowed size exceeded` from np.linspace
         (["--scans", "99999999999999999999"], "--scans must be between 1 and 1000 scans per"),
         (["--scans", "1001"], "--scans must be between 1 and 1000 scans per held-out world"),
         (["--repeats", "1001"], "--repeats must be between 1 and 1000, got 1001"),
@@ -803,8 +803,8 @@ def test_bench_on_a_log_takes_more_scans_than_it_has(short_clf, capsys):
 
 
 def test_slam_writes_its_outputs_all_or_none(short_clf, tmp_path, monkeypatch, capsys):
-    """issue 13: a failure writing a later output (the map) left the earlier one (the
-    trajectory) behind; now the outputs are renamed into place together, or not at all."""
+    """A failure writing a later output (the map) leaves no earlier one (the trajectory)
+    behind: the outputs are renamed into place together, or not at all."""
     import fhslam.io
     from fhslam.errors import InputError
 
@@ -846,7 +846,8 @@ def _corridor(tmp_path, length: float):
 
 
 def test_simulate_refuses_a_route_beyond_the_scan_limit_before_any_work(tmp_path):
-    """issue 13: a world 100 km long ran for minutes without a word (1.25 million scans)."""
+    """A world 100 km long (1.25 million scans) is refused at once, not run for minutes
+    without a word."""
     import time
 
     world = _corridor(tmp_path, 1e5)
@@ -884,7 +885,7 @@ def test_the_help_names_every_built_in_world():
 
 
 def test_slam_robustness_options_run_the_degraded_log(short_clf, tmp_path, capsys):
-    """``--range-noise``, ``--drop-scans``, ``--clutter`` and ``--last-bit`` (issue 10's
+    """``--range-noise``, ``--drop-scans``, ``--clutter`` and ``--last-bit`` (the
     robustness checks) run exactly ``fhslam.sim.degrade`` then ``perturb_odometry`` on the
     log, say so, and record it in the trajectory's header."""
     from fhslam.pipeline import run_slam

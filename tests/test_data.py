@@ -133,9 +133,9 @@ def test_bad_kind_and_missing_log():
 
 
 def test_a_dataset_of_relations_only_is_no_log(monkeypatch):
-    """Issue 13: ``fhslam info mit-killian`` (slam, bench --log) ended in a traceback,
-    ``ValueError: dataset 'mit-killian' has no log file``: an InputError now, saying what the
-    dataset has and what it is for (its relations are found as before)."""
+    """``fhslam info mit-killian`` (slam, bench --log) is an InputError, not a traceback
+    (``ValueError: dataset 'mit-killian' has no log file``), saying what the dataset has and
+    what it is for (its relations are still found)."""
     from fhslam.datasets import load_log
 
     with pytest.raises(InputError) as e:

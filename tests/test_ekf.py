@@ -148,7 +148,7 @@ def test_landmarks_through_the_origin_keep_their_extent():
     assert map_error(r.map, log.world.walls) < 0.05  # was 0.66 m with mirrored extents
 
 
-# ------------------------------------------------------- landmark flips (issue 10)
+# ------------------------------------------------------------------ landmark flips
 
 
 def _started(pose=(0.0, 0.0, 0.0)) -> EKFLineSLAM:
@@ -235,7 +235,7 @@ def test_the_filter_runs_in_the_frame_of_its_first_pose():
 
 
 def test_the_landmark_limit_bounds_the_state_and_warns_once():
-    # issue 13: the dense covariance made a step cost 1.5 s at several hundred landmarks
+    # without the limit the dense covariance makes a step cost 1.5 s at several hundred landmarks
     from fhslam.pipeline import run_slam
     from fhslam.sim import load_world, simulate
     from fhslam.slam.ekf import EKFLandmarkLimitWarning, EKFParams
@@ -300,10 +300,10 @@ def staggered_corridor(pairs: int = 24):
 
 
 def test_the_trajectory_does_not_depend_on_the_blas_thread_count():
-    """Issue 13: filterpy's dense covariance products are split over OpenBLAS threads once the
-    covariance is large enough (above 64 x 64), which changed the trajectory's last bits with
-    the thread count (so with the machine's core count) and made a run 10x slower on busy
-    cores. The filter now runs on one BLAS thread: bit-identical at 1 and 2 threads, the
+    """Filterpy's dense covariance products are split over OpenBLAS threads once the
+    covariance is large enough (above 64 x 64), which changes the trajectory's last bits with
+    the thread count (so with the machine's core count) and makes a run 10x slower on busy
+    cores. So the filter runs on one BLAS thread: bit-identical at 1 and 2 threads, the
     caller's setting untouched after. Measured without the limit on this log: the poses
     differ from scan 131 on (by 6e-14 m); on MIT CSAIL from scan 186 on (by 8e-12 m)."""
     from threadpoolctl import ThreadpoolController, threadpool_limits

@@ -10,7 +10,7 @@ the package's calls and compared:
   procedure and the EKF must still agree within 1e-6 (metres, radians): last-bit
   differences measured under another OpenBLAS kernel set stay below 1e-9 there. The pose-graph
   method (``graph``) is not compared then: its correlative search picks among near-equal
-  scores, so last-bit noise moves it by centimetres (issue 10 makes it robust).
+  scores, so last-bit noise moves it by centimetres (the robustness tests bound that).
 """
 
 from __future__ import annotations

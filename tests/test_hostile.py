@@ -1,6 +1,6 @@
 """A corpus of malformed and implausible inputs, each run through the ``fhslam`` command.
 
-Every case must end in one of two ways (DESIGN.md, "Bad input"):
+Every case must end in one of two ways (the contract in fhslam/cli.py's module docstring):
 
 - ``error``: exit status 2 and exactly one line on stderr, ``fhslam: error: ...``, that names
   the offending file (and its line where there is one); no output written, no temporary file
@@ -294,8 +294,8 @@ def _log_cases() -> list[Case]:
 
 def _robotlaser1_cases() -> list[Case]:
     """``ROBOTLASER1`` lines: malformed ones, readings no laser gives, and a header that
-    states what no laser has (issue 13: a maximum_range of 0 ended in a traceback, a
-    resolution of 0 or 100 rad was read silently)."""
+    states what no laser has (a maximum_range of 0, a resolution of 0 or 100 rad: errors, not
+    a traceback or silence)."""
     n = int(BASE_RL[RL_LINES[0]].split()[8])
     cases = []
     for value, what in [("abc", "not-a-number"), ("nan", "nan"), ("inf", "inf"),
@@ -414,7 +414,7 @@ def _path_cases() -> list[Case]:
         Case("unknown-dataset", ["slam", "nosuchlog", "--trajectory", "{d}/" + OUT], {},
              "error", ["nosuchlog"]),
         Case("info-missing", ["info", "{d}/none.clf"], {}, "error", ["none.clf"]),
-        # issue 13: a named pipe hung every command that read it (is_bag opened it)
+        # a named pipe is refused unopened: opening it (as is_bag would) hangs the command
         Case("log-is-a-fifo", ["slam", "{d}/ff", "--trajectory", "{d}/" + OUT], {"ff": FIFO},
              "error", ["ff: is not a regular file"]),
         Case("info-fifo", ["info", "{d}/ff"], {"ff": FIFO}, "error", ["ff: is not a regular"]),
@@ -424,7 +424,7 @@ def _path_cases() -> list[Case]:
              ["ff.db3: is not a regular file"]),
         Case("bench-fifo", ["bench", "--log", "{d}/ff", "--quiet"], {"ff": FIFO}, "error",
              ["ff: is not a regular file"]),
-        # issue 13: a registered dataset with relations only ended in a traceback
+        # a registered dataset with relations only: an error, not a traceback
         Case("slam-relations-only-dataset", ["slam", "mit-killian", "--trajectory",
              "{d}/" + OUT], {}, "error", ["dataset 'mit-killian' has only relations"]),
         Case("info-relations-only-dataset", ["info", "mit-killian"], {}, "error",

@@ -3,7 +3,7 @@
 that are broken, the commands' outputs checked before any work and written all or none, and
 Ctrl-C.
 
-The contract is the corpus's (its docstring, DESIGN.md "Bad input"): bad input ends in exit
+The contract is the corpus's (its docstring; fhslam/cli.py's): bad input ends in exit
 status 2 and one line ``fhslam: error: ...`` naming the path, with nothing written and no
 input changed; Ctrl-C (SIGINT) ends in exit status 130 and one line
 ``fhslam: interrupted; ...`` naming what was not written, with no traceback and no file left.
@@ -199,8 +199,8 @@ def test_an_output_folder_it_created_is_removed_if_the_work_fails(tmp_path):
 
 
 # --------------------------------------------------------------------------------------------
-# Outputs that cannot be written: refused before the work (issue 13: slam ran the whole log,
-# wrote the trajectory, then failed on the map; sweep failed only after the whole sweep)
+# Outputs that cannot be written: refused before the work (not slam running the whole log,
+# writing the trajectory, then failing on the map; nor sweep failing after the whole sweep)
 
 
 def test_slam_refuses_an_unwritable_map_folder_before_reading_the_log(
@@ -289,7 +289,8 @@ def test_sweep_warns_once_of_an_unknown_world_key(tmp_path):
 
 
 # --------------------------------------------------------------------------------------------
-# reproduce (issue 13: FileExistsError, PermissionError, FileNotFoundError tracebacks)
+# reproduce (one-line errors, not FileExistsError, PermissionError, FileNotFoundError
+# tracebacks)
 
 
 def test_reproduce_refuses_a_file_as_its_folder(tmp_path, monkeypatch, capsys):
@@ -335,8 +336,8 @@ def test_reproduce_that_fails_midway_leaves_no_figure_and_no_folder(tmp_path, mo
 
 
 # --------------------------------------------------------------------------------------------
-# student-copy (issue 13: FileExistsError, PermissionError; a broken notebook left the copies
-# of the notebooks before it)
+# student-copy (one-line errors, not FileExistsError, PermissionError tracebacks; a broken
+# notebook leaves no copies of the notebooks before it)
 
 
 def test_student_copy_refuses_a_file_as_its_folder(tmp_path, capsys):
@@ -429,8 +430,8 @@ def test_a_notebook_and_its_py_are_written_together_or_not_at_all(tmp_path, caps
 
 
 # --------------------------------------------------------------------------------------------
-# Ctrl-C (issue 13: a 30-line KeyboardInterrupt traceback; sweep also warned of leaked
-# semaphores; run-notebooks printed three tracebacks). Each command is started as a separate
+# Ctrl-C (not a 30-line KeyboardInterrupt traceback, nor sweep's warnings of leaked
+# semaphores, nor run-notebooks' three tracebacks). Each command is started as a separate
 # process, sent SIGINT once it is under way (as a terminal does: to its whole process group,
 # workers and kernels included), and must end with one line and exit status 130.
 
@@ -514,7 +515,7 @@ def test_sweep_interrupted_prints_one_line_and_no_leaked_semaphores(tmp_path, se
     code, out, err = interrupt(
         [*argv, "--out", "s.csv"], lambda out, err: "SLAM sweep" in err, tmp_path, settle
     )
-    # Known and accepted (1 CI run in 2 at stop 23, never reproduced here in 40 runs): loky's
+    # Known and accepted (1 CI run in 2 once, never reproduced here in 40 runs): loky's
     # resource tracker, a process of its own, sometimes reports one of its semaphores as
     # leaked and then finds it already unlinked (FileNotFoundError): the parent removed it,
     # and the tracker missed the message. Nothing is left behind; the lines are loky's.

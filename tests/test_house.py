@@ -1,4 +1,4 @@
-"""The house (issue 9): one-way layers, a lazy public API, README examples that run."""
+"""The house: one-way layers, a lazy public API, README examples that run."""
 
 from __future__ import annotations
 

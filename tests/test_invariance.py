@@ -1,4 +1,4 @@
-"""Where the world frame lies must not matter (issue 10).
+"""Where the world frame lies must not matter.
 
 Every SLAM method run on a world and on the same world moved rigidly (walls, route, start,
 and with them the odometry frame) must give the same trajectory up to that motion: the
@@ -91,29 +91,28 @@ def test_fh_slam_on_the_hall_in_its_own_frame():
 def test_graph_trajectory_does_not_depend_on_the_world_frame(world, motion):
     """The default method runs in its first pose's frame: its grids and voxels are aligned
     with that frame, not the world's, so a moved world changes only the final composition
-    (before, grids aligned with the world's axes made runs differ by 1.5-5 cm)."""
+    (grids aligned with the world's axes would make runs differ by 1.5-5 cm)."""
     own, _, log = _run(world, (0.0, 0.0, 0.0), "graph")
     moved, _, _ = _run(world, motion, "graph")
     dpos, dth = _pose_difference(moved, own)
     # Not 1e-6: the moved world's odometry differs in the last bits (3.8e-13 m), and the
     # graph's discrete choices (search cells, nearest neighbours) let such differences grow
-    # to millimetres, as another CPU would. Measured at most 13.8 mm and 0.13° (stop 44's
-    # machine) and 15.3 mm and 0.09° (the hall turned by 37°, rms 7.7 mm; stop 47's), where
-    # a last-bit draw of the odometry alone (perturb_odometry) moves the hall by at most
-    # 3.6 mm and the corridor by 9.1 mm: not solved, bounded here within issue 10's limit.
+    # to millimetres, as another CPU would. Measured at most 13.8 mm and 0.13° on one machine
+    # and 15.3 mm and 0.09° on another (the hall turned by 37°, rms 7.7 mm), where a last-bit
+    # draw of the odometry alone (perturb_odometry) moves the hall by at most 3.6 mm and the
+    # corridor by 9.1 mm: not solved, bounded here within the 3 cm limit for a simulated world.
     assert dpos <= 0.02 and dth <= np.radians(0.3), f"{dpos:.3g} m, {dth:.3g} rad"
-    assert ate(own, log.truth).rmse <= 0.03  # issue 10's limit for simulated worlds
+    assert ate(own, log.truth).rmse <= 0.03  # the limit for simulated worlds
     assert ate(moved, log.truth).rmse <= 0.03
 
 
 @pytest.mark.parametrize("motion", MOTIONS.values(), ids=MOTIONS.keys())
 def test_graph_meets_the_limit_on_the_offices_floor_in_every_frame(motion):
-    """The ``offices`` floor (its corridor driven back the other way) was more sensitive to
-    the last bits than the hall and the corridor: its poses moved by up to 4.5 cm between
-    frames (stop 27), so the test bounds each frame's ATE by issue 10's limit instead.
-    Measured at stop 43: poses 0.8, 1.1 and 0.7 cm apart for these motions; ATE 1.39 cm in
-    the own frame (as run here), 1.27, 1.34 and 1.39 cm moved. At stop 44: 0.7, 0.9 and 0.6
-    cm apart; ATE 1.32 cm in the own frame, 1.22, 1.22 and 1.32 cm moved."""
+    """The ``offices`` floor (its corridor driven back the other way) is more sensitive to
+    the last bits than the hall and the corridor: its poses have moved by up to 4.5 cm
+    between frames, so the test bounds each frame's ATE by the 3 cm limit for a simulated
+    world instead. Measured: poses 0.7, 0.9 and 0.6 cm apart for these motions; ATE 1.32 cm
+    in the own frame (as run here), 1.22, 1.22 and 1.32 cm moved."""
     own, _, log = _run("offices", (0.0, 0.0, 0.0), "graph")
     moved, _, _ = _run("offices", motion, "graph")
     assert ate(own, log.truth).rmse <= 0.03

@@ -114,9 +114,9 @@ def _readers():
 @pytest.mark.skipif(not hasattr(os, "mkfifo"), reason="no FIFOs on this platform")
 @pytest.mark.parametrize("suffix", ["", ".clf", ".bag", ".db3", ".json", ".txt"])
 def test_no_reader_opens_a_fifo(tmp_path, suffix):
-    """Issue 13: ``mkfifo ff; fhslam info ff`` hung for ever, since ``is_bag`` opened the
-    FIFO (waiting for a writer) before any reader checked it is a regular file. Every reader
-    refuses it, naming it, without opening it; ``is_bag`` says no."""
+    """``mkfifo ff; fhslam info ff`` must not hang for ever, as it would if ``is_bag`` opened
+    the FIFO (waiting for a writer) before any reader checked it is a regular file. Every
+    reader refuses it, naming it, without opening it; ``is_bag`` says no."""
     import signal
 
     from fhslam.io import is_bag

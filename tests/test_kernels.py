@@ -195,7 +195,7 @@ def test_scan_normals_equal_numpy_bit_for_bit(half_window, paper_scans):
 
 @pytest.mark.parametrize("half_window", [1, 2, 3, 4])
 def test_smooth_scan_equals_numpy_bit_for_bit(half_window, paper_scans):
-    """:func:`smooth_scan` (the window sums, turn tests and spreads compiled, stop 43)
+    """:func:`smooth_scan` (the window sums, turn tests and spreads compiled)
     equals :func:`_smooth_scan_numpy` bit for bit: real scans (the paper world's and a noisy
     walk along walls with corners), NaN normals, identical points, windows that fail every
     test, and scans shorter than, equal to and one longer than the window."""

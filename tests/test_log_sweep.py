@@ -1,5 +1,5 @@
 """``fhslam sweep --log``: a real log as read and degraded with seeds 0..N-1, each run measured
-against its relations, and the runs beyond issue 10's bound (25 % or 1 cm) counted.
+against its relations, and the runs beyond the robustness bound (25 % or 1 cm) counted.
 
 A simulated log written as a CARMEN file, with relations taken from its ground truth, stands
 in for a real one here (seconds instead of minutes); the shared logs go the same way.
@@ -114,7 +114,7 @@ def _run(error, seed=-1, last_bit=0):
         (0.02, 0.031, True),
     ],
 )
-def test_beyond_is_issue_10s_bound(reference, error, out):
+def test_beyond_is_the_robustness_bound(reference, error, out):
     assert beyond(_run(error, 0), _run(reference)) is out
 
 
@@ -134,8 +134,8 @@ def test_graph_parameters_reach_the_runs(hall, capsys):
     from fhslam.slam import GraphSlamParams
 
     """``--set`` (``params``): keyframes every metre instead of every half metre move the
-    run; the table says so. (The printed table rounds to 0.1 mm: on the machine of stop 47
-    both runs printed 0.0026 m, so the runs are compared at full precision.)"""
+    run; the table says so. (The printed table rounds to 0.1 mm: on one machine both runs
+    printed 0.0026 m, so the runs are compared at full precision.)"""
     path, relations = hall
     args = ["sweep", "--log", str(path), "--relations", str(relations), "--seeds", "1",
             "--range-noise", "0.001", "--jobs", "1", "--quiet"]  # fmt: skip
@@ -236,8 +236,8 @@ def _drawn(seed: int, error: float, method: str = "graph", last_bit: int = 0) ->
 
 
 def test_the_picture_marks_the_runs_beyond_the_bound():
-    """``sweep_errors_figure``: a panel per method, the run as read as a line with issue 10's
-    bound as a band about it, the runs beyond it red and labelled with their error."""
+    """``sweep_errors_figure``: a panel per method, the run as read as a line with the
+    robustness bound as a band about it, the runs beyond it red and labelled with their error."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -261,7 +261,7 @@ def test_the_picture_marks_the_runs_beyond_the_bound():
         assert [t.get_text() for t in left.get_xticklabels()] == ["as read", "0", "1", "2"]
     finally:
         plt.close(fig)
-    # a reference of 3 mm: the band is issue 10's 1 cm, so 9 mm off is within it
+    # a reference of 3 mm: the band is the bound's 1 cm, so 9 mm off is within it
     small = sweep_errors_figure([_drawn(-1, 0.003), _drawn(0, 0.012), _drawn(1, 0.0135)])
     try:
         assert small.axes[0].get_title() == "graph: 2 runs, 1 beyond the bound"

@@ -124,7 +124,7 @@ def test_merging_collinear_segments_is_order_independent_and_idempotent(pieces):
     assert again.n == m1.n + b.n
 
 
-# ------------------------------------------------------------ frame invariance (issue 10)
+# --------------------------------------------------------------------- frame invariance
 
 
 def wall_y0(x0, x1, rho, theta, n=20):

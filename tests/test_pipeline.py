@@ -162,8 +162,8 @@ def test_reference_map_nearby_uses_the_segments():
 
 @pytest.mark.parametrize("method", list(METHODS))
 def test_no_method_depends_on_the_blas_thread_count(method):
-    """Issue 13: every method gives the same bits with BLAS on 1 and on 2 threads (the
-    EKF's dense covariance is the one place threaded BLAS changed them: it limits itself to
+    """Every method gives the same bits with BLAS on 1 and on 2 threads (the
+    EKF's dense covariance is the one place threaded BLAS changes them: it limits itself to
     one thread; fht, graph and classical use no BLAS large enough to be threaded: on MIT
     CSAIL and Intel, OPENBLAS_NUM_THREADS=1 and =2 gave identical trajectories and the BLAS
     worker threads no CPU time)."""

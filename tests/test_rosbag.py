@@ -168,7 +168,7 @@ def test_intel_bag_matches_its_relations_and_published_odometry_error(real_data)
     t1, t2, rel = read_relations(real_data / "intel.relations")
     e = relations_error(log.timestamps, log.odometry, t1, t2, rel)
     assert e.n_used == e.n_total == 2984  # every relation stamp is a scan stamp
-    assert e.trans_mean == pytest.approx(7.38, abs=0.005)  # issue 5: "raw odometry 7.38 m"
+    assert e.trans_mean == pytest.approx(7.38, abs=0.005)  # the raw odometry's 7.38 m
 
 
 def test_fr079_laser_offset_from_tf_static(real_data):
@@ -198,7 +198,7 @@ def test_an_interlaced_laser_gets_per_scan_bearing_offsets(tmp_path):
 
 def test_fr079_loaded_as_a_dataset_gets_its_original_mount(real_data, tmp_path):
     """The bag publishes base_link -> laser x = +0.04 m; the original CARMEN log states
-    ``robot_frontlaser_offset -0.04`` (issue 10, item 4). The relations side with the log
+    ``robot_frontlaser_offset -0.04``. The relations side with the log
     (default SLAM: 0.0301 m with -0.04 against 0.0636 m with +0.04), so the dataset loader
     corrects the mount of the dataset's file, found by name or by file name and size; the
     reader reports the file as it is, and any other file keeps its own mount."""
@@ -220,7 +220,7 @@ def test_fr079_loaded_as_a_dataset_gets_its_original_mount(real_data, tmp_path):
 
 
 def test_scans_out_of_time_order_are_sorted_with_a_warning(tmp_path):
-    """Issue 13: a bag's scans whose header stamps go back in time were sorted silently."""
+    """A bag's scans whose header stamps go back in time are sorted with a warning."""
     from fhslam.io import BagWarning
 
     path = write_bag(tmp_path / "b.bag", scans=5, stamps=[10, 11, 13, 12, 12])
@@ -243,9 +243,9 @@ def _wall_and_far_wall(k, a):
 
 
 def test_a_reading_repeated_far_below_range_max_is_no_no_return_code(tmp_path):
-    """Issue 13: a bag stating range_max 80 m whose 30 scans repeat took the 2.0 m straight
-    ahead (read 30 times) for the no-return code: every reading at or beyond 2 m was
-    dropped, every scan empty. A code is sought in the upper half of the stated range."""
+    """A bag stating range_max 80 m whose 30 scans repeat must not take the 2.0 m straight
+    ahead (read 30 times) for the no-return code, dropping every reading at or beyond 2 m
+    and leaving every scan empty. A code is sought in the upper half of the stated range."""
     from fhslam.io import no_return_reading
 
     path = write_bag(tmp_path / "still.bag", scans=30, ranges=_wall_and_far_wall)
@@ -318,10 +318,10 @@ def test_a_code_near_range_max_is_still_found(tmp_path):
     ],
 )  # fmt: skip
 def test_what_no_laser_or_odometry_gives_is_refused_naming_the_message(tmp_path, kw, message):
-    """Issue 13: range_max 0, -1 or NaN ended in a traceback (Log.max_range must be
-    positive), a NaN pose in another (odometry must be finite), one beam in a
-    ZeroDivisionError; an increment of 0 or 10 rad and an all-zero quaternion (read as
-    heading 0) were read silently."""
+    """Refused with a message, not a traceback: range_max 0, -1 or NaN (Log.max_range must be
+    positive), a NaN pose (odometry must be finite), one beam (a ZeroDivisionError); and not
+    read silently: an increment of 0 or 10 rad and an all-zero quaternion (read as heading
+    0)."""
     path = write_bag(tmp_path / "x.bag", scans=4, **kw)
     with pytest.raises(BagFormatError, match=r"x\.bag: .*" + message):
         read_bag(path)
@@ -351,7 +351,7 @@ def test_ros_no_return_codes_are_read_without_a_warning(tmp_path):
 
 
 def test_a_leap_of_more_than_a_day_is_warned(tmp_path):
-    """Issue 13: time going back was warned, a leap forward of 1e9 s was not."""
+    """A leap forward of 1e9 s is warned of, as time going back is."""
     from fhslam.io import BagWarning
 
     path = write_bag(tmp_path / "t.bag", scans=4, stamps=[10, 11, 10**9, 10**9 + 1])

@@ -418,7 +418,7 @@ BOX = {"walls": [[0, 0, 6, 0], [6, 0, 6, 4], [6, 4, 0, 4], [0, 4, 0, 0]], "route
 @pytest.mark.parametrize(
     ("changes", "message"),
     [
-        # issue 13: `true` was read as 1, "1" as 1, null in 'start' as NaN ("not finite")
+        # `true` is not read as 1, nor "1" as 1, nor null in 'start' as NaN ("not finite")
         ({"walls": [*BOX["walls"][:3], [0, 4, 0, True]]},
          "field 'walls' must be a list of [number, number, number, number] rows: row 3 holds "
          "true, which is not a number"),
@@ -442,7 +442,7 @@ def test_a_world_coordinate_must_be_a_json_number(tmp_path, changes, message):
 
 
 def test_a_world_nested_too_deeply_is_a_format_error(tmp_path):
-    # issue 13: 100,000 nested '[' was a RecursionError from the json module
+    # 100,000 nested '[': a format error, not a RecursionError from the json module
     path = tmp_path / "deep.json"
     path.write_text("[" * 100_000)
     with pytest.raises(WorldFormatError, match=r"deep\.json: not a world: its JSON is nested too"):
@@ -450,8 +450,8 @@ def test_a_world_nested_too_deeply_is_a_format_error(tmp_path):
 
 
 def test_an_unknown_world_key_is_ignored_with_one_warning(tmp_path):
-    """issue 13: a misspelled key ("strat") was ignored without a word; now it is still
-    ignored (the world is well defined without it) but named, with the keys a world has."""
+    """A misspelled key ("strat") is ignored (the world is well defined without it), but not
+    without a word: it is named, with the keys a world has."""
     from fhslam.errors import InputWarning
 
     path = tmp_path / "w.json"
@@ -736,7 +736,7 @@ def test_degrade_rejects_bad_arguments(paper_log, kwargs, match):
 
 
 def test_degrade_range_noise_on_valid_beams_only(paper_log):
-    """Issue 10's robustness check: Gaussian noise of 1 mm on every return, none on a
+    """The robustness check: Gaussian noise of 1 mm on every return, none on a
     no-return, every return still one (inside (0, max_range))."""
     out = degrade(paper_log, range_noise=0.001, seed=5)
     valid = (paper_log.ranges > 0) & (paper_log.ranges < paper_log.max_range)
@@ -810,8 +810,8 @@ def test_expected_scans_is_within_six_per_cent_of_the_drive(name):
 
 
 def test_a_route_beyond_the_scan_limit_is_refused_before_any_work(monkeypatch):
-    """issue 13: a 100 km route was simulated for minutes without a word; simulate() now
-    refuses a route of more than MAX_SCANS scans before driving it."""
+    """A 100 km route is not simulated for minutes without a word: simulate() refuses a
+    route of more than MAX_SCANS scans before driving it."""
     import sys
 
     from fhslam.errors import InputError

@@ -39,7 +39,7 @@ def observe(world_lines, pose):
     th=st.floats(-np.pi, np.pi),
 )
 def test_calibration_recovers_a_known_pose_offset(dx, dy, dth, x, y, th):
-    """< 1 cm and < 0.1° from offsets up to 30 cm and 4.6° (issue 3)."""
+    """< 1 cm and < 0.1° from offsets up to 30 cm and 4.6°."""
     truth = np.array([x, y, th])
     observed = observe(ROOM_LINES, truth)
     predicted = compose(truth, (dx, dy, dth))
@@ -110,7 +110,7 @@ def _run(name, laps, degraded=False):
 
 
 @pytest.mark.parametrize("world", HELD_OUT)
-def test_fh_slam_on_held_out_worlds_meets_issue_3(world):
+def test_fh_slam_on_held_out_worlds_meets_its_limits(world):
     m = _run(world, laps=3)
     assert 2.0 <= m["drift"] <= 6.0  # the odometry really drifts 2-6 m
     assert m["ate"] <= 0.15 and m["ate"] <= 0.2 * m["odometry_ate"]

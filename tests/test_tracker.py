@@ -147,10 +147,10 @@ def test_a_straight_corridor_with_perfect_odometry_keeps_its_heading():
     """The ring's first straight (480 scans, 47 m; 1 cm range noise) with perfect odometry:
     the front end's tracked heading ends within 0.6° of the truth (measured 0.44°). The
     keyframe clouds' voxel grid runs along the walls when the robot drives parallel to them,
-    and which noisy point each 2 cm cell keeps tilts every keyframe's walls the same way
-    (README, 'Where the ring's heading drift comes from'): 1.11, 0.83, 1.36 and 1.00° over
+    and which noisy point each 2 cm cell keeps tilts every keyframe's walls the same way:
+    1.11, 0.83, 1.36 and 1.00° over
     seeds 0-3 unless each scan is smoothed along its beams before it enters a cloud
-    (``smooth_clouds``, the default since stop 43; tests/test_graphslam.py compares both).
+    (``smooth_clouds``, the default; tests/test_graphslam.py compares both).
     Without range noise it ends 0.05° off, with the correlative search alone 0.00° (it
     keeps the prediction)."""
     log = simulate(load_world("ring"), seed=0, odometry=OdometryNoise.none(), max_scans=480)

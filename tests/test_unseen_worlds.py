@@ -1,14 +1,14 @@
-"""The default SLAM on worlds nobody tuned on (issue 10: "held-out simulated worlds (any
-frame): ATE ≤ 3 cm").
+"""The default SLAM on worlds nobody tuned on (held-out simulated worlds, in any frame:
+ATE ≤ 3 cm).
 
-``random:300`` … ``random:303`` were drawn for this test at stop 50 and used for nothing
-else: no default was chosen by looking at them. Each is driven three laps with drifting
-odometry (2–6 m off), its frame moved by (−3.3, 2.1) m and turned 37°, with 1 mm of noise on
-every range and 10 % of the scans dropped — the hardest of the conditions issue 10 names,
-all at once. Measured at stop 50 (README, *SLAM on simulated worlds*): ATE 0.33, 0.37, 0.52
-and 0.43 cm; the same four conditions over ``random:300`` … ``random:339`` stay within
-0.30–0.92 cm (README). The bound is issue 10's limit, not the measurement: the test says the
-defaults generalise, not that these four numbers hold to the last bit.
+``random:300`` … ``random:303`` were drawn for this test and used for nothing else: no
+default was chosen by looking at them. Each is driven three laps with drifting odometry
+(2–6 m off), its frame moved by (−3.3, 2.1) m and turned 37°, with 1 mm of noise on every
+range and 10 % of the scans dropped — the hardest of the robustness conditions, all at
+once. Measured: ATE 0.33, 0.37, 0.52 and 0.43 cm; the same four conditions over
+``random:300`` … ``random:339`` stay within 0.30–0.92 cm. The bound is the 3 cm limit for a
+simulated world, not the measurement: the test says the defaults generalise, not that these
+four numbers hold to the last bit.
 """
 
 from __future__ import annotations
@@ -22,7 +22,7 @@ from fhslam.sim import degrade, load_world, simulate, transform_world
 from fhslam.sim.odometry import OdometryNoise
 
 LIMIT_M = 0.03
-"""Issue 10's limit for held-out simulated worlds, in any frame."""
+"""The ATE limit for held-out simulated worlds, in any frame."""
 
 
 @pytest.mark.parametrize("world", [f"random:{s}" for s in range(300, 304)])

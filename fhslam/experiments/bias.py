@@ -1,6 +1,6 @@
 """One refinement at a time: where the tracker's point-to-line refinement places a scan,
 against a map of the scans before it at their *true* poses, measured from the truth along
-the robot's heading (README, *Not solved: long corridors*, stops 32, 48 and 49).
+the robot's heading.
 
 Along the ``ring``'s corridors the SLAM comes out 0.20-0.24 % too large: each keyframe is
 placed a little ahead. This takes the tracker's part apart from the rest (no odometry

@@ -2,7 +2,7 @@
 
 :func:`slam_sweep` runs every method on the same simulated logs (seeds × odometry-noise
 levels; optionally degraded as real logs are, and each also with its odometry perturbed in
-the last bit: issue 10's robustness checks) through :mod:`joblib`, so the same code runs on
+the last bit: the robustness checks) through :mod:`joblib`, so the same code runs on
 the local cores or, through joblib's backends, on a Dask or Ray cluster; every run is
 seeded, and the rows come back in a fixed order whatever the backend.
 """
@@ -305,7 +305,7 @@ LAST_BIT_MOVE = 0.001
 @dataclass(frozen=True)
 class LastBitSpread:
     """How much the last bit of the odometry moves one (level, method)'s ATE in a sweep
-    (issue 10: a result that changes under floating-point noise is not robust)."""
+    (a result that changes under floating-point noise is not robust)."""
 
     largest: float
     """The largest difference (m) between two runs of one log that differ only in the

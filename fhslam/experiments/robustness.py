@@ -1,12 +1,12 @@
 """How far a SLAM result on a real log moves when the log is degraded (``fhslam sweep --log``).
 
-Issue 10 asks that 1 mm of Gaussian noise on every range, or 10 % of the scans dropped, change
-no log's relation error by more than 25 % or 1 cm, whichever is larger (:func:`beyond`). One
-degraded run says little where a result turns on luck (the Freiburg hospital's return is
-found or missed: README); :func:`log_sweep` runs the log as read and degraded with seeds
-``0 .. N-1`` (:func:`fhslam.sim.degrade`), and optionally with its odometry perturbed in the
-last bit (:func:`fhslam.sim.perturb_odometry`), in parallel, each run measured against the
-log's benchmark relations (:func:`fhslam.metrics.relations_error`).
+The robustness bound: 1 mm of Gaussian noise on every range, or 10 % of the scans dropped,
+may change no log's relation error by more than 25 % or 1 cm, whichever is larger
+(:func:`beyond`). One degraded run says little where a result turns on luck (the Freiburg
+hospital's return is found or missed); :func:`log_sweep` runs the log as read and degraded
+with seeds ``0 .. N-1`` (:func:`fhslam.sim.degrade`), and optionally with its odometry
+perturbed in the last bit (:func:`fhslam.sim.perturb_odometry`), in parallel, each run
+measured against the log's benchmark relations (:func:`fhslam.metrics.relations_error`).
 """
 
 from __future__ import annotations
@@ -39,8 +39,8 @@ from fhslam.sim.degrade import check_degradation
 __all__ = ["LOG_FIELDS", "LogRun", "beyond", "format_log_sweep", "log_sweep", "save_log_sweep"]
 
 RELATIVE_BOUND = 0.25
-"""Issue 10: a degraded run may change the relation error by this share of the run's on the
-log as read, or by :data:`ABSOLUTE_BOUND`, whichever is larger."""
+"""The robustness bound: a degraded run may change the relation error by this share of the
+run's on the log as read, or by :data:`ABSOLUTE_BOUND`, whichever is larger."""
 ABSOLUTE_BOUND = 0.01
 """See :data:`RELATIVE_BOUND`, metres."""
 
@@ -84,8 +84,8 @@ LOG_FIELDS = tuple(f.name for f in fields(LogRun))
 
 
 def beyond(run: LogRun, reference: LogRun) -> bool:
-    """Whether ``run``'s relation error differs from ``reference``'s by more than issue 10
-    allows: 25 % of the reference's, or 1 cm, whichever is larger."""
+    """Whether ``run``'s relation error differs from ``reference``'s by more than the
+    robustness bound allows: 25 % of the reference's, or 1 cm, whichever is larger."""
     bound = max(RELATIVE_BOUND * reference.trans_error, ABSOLUTE_BOUND)
     return bool(abs(run.trans_error - reference.trans_error) > bound)
 
@@ -220,7 +220,7 @@ def degradation_text(run: LogRun) -> str:
 
 def format_log_sweep(rows: Sequence[LogRun]) -> str:
     """Per method: the reference run, then the degraded runs' median and largest error and
-    those beyond issue 10's bound (:func:`beyond`), by seed (what ``fhslam sweep --log``
+    those beyond the robustness bound (:func:`beyond`), by seed (what ``fhslam sweep --log``
     prints)."""
     lines = []
     for method in dict.fromkeys(r.method for r in rows):

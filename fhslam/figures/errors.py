@@ -120,7 +120,7 @@ def sweep_errors_figure(
     the ``reference`` property of :class:`fhslam.experiments.robustness.LogRun`) as a point:
     its mean translational relation error over its degradation seed (the runs on the log as
     read at "as read", last-bit draws beside their seed), one panel per method, with the run
-    on the log as read as a line and issue 10's bound about it (``relative`` of its error or
+    on the log as read as a line and the robustness bound about it (``relative`` of its error or
     ``absolute`` metres, whichever is larger) as a band; the runs beyond it red and labelled.
 
     Raises
@@ -150,7 +150,7 @@ def sweep_errors_figure(
         ax.axhspan(max(ref - bound, ref / 10), ref + bound, color="0.9", lw=0)
         ax.axhline(ref, color="k", lw=1, label=f"as read {ref:.4f} m (band: ± {bound:.3g} m)")
         ax.scatter([-1], [ref], s=18, color="k")
-        ax.scatter(x[~out], e[~out], s=18, color="tab:blue", label="within issue 10's bound")
+        ax.scatter(x[~out], e[~out], s=18, color="tab:blue", label="within the robustness bound")
         ax.scatter(x[out], e[out], s=24, color="tab:red", label="beyond it")
         for xi, ei in zip(x[out], e[out], strict=True):
             ax.annotate(f"{ei:.3g} m", (xi, ei), textcoords="offset points", xytext=(4, 3),

@@ -1,4 +1,4 @@
-"""Map files: the SLAM map's feature lines as JSON (the format is in DESIGN.md).
+"""Map files: the SLAM map's feature lines as JSON.
 
 ::
 

@@ -3,7 +3,7 @@ and perturb its odometry in the last bit, as another CPU would.
 
 :func:`degrade` and :func:`perturb_odometry` work on any :class:`~fhslam.io.log.Log`,
 simulated or read from a file; the ground truth and wall hits of a simulated log follow the
-kept scans. They make issue 10's robustness checks (``fhslam slam LOG --range-noise 0.001``,
+kept scans. They make the robustness checks (``fhslam slam LOG --range-noise 0.001``,
 ``--drop-scans 0.1``, ``--last-bit 1``).
 """
 
@@ -200,8 +200,8 @@ def perturb_odometry(log: Log, seed: int, relative: float = LAST_BIT) -> Log:
     normal, one per value, drawn with ``seed``.
 
     With the default ``relative`` this is what the same code on another CPU does (fused
-    multiply-adds, other library builds): a result that changes much under it is not robust
-    (issue 10). ``fhslam slam LOG --last-bit SEED`` runs it.
+    multiply-adds, other library builds): a result that changes much under it is not
+    robust. ``fhslam slam LOG --last-bit SEED`` runs it.
 
     Raises
     ------

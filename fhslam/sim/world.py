@@ -1,6 +1,6 @@
 """Polygonal worlds: wall segments plus the route the simulated robot drives.
 
-A world is stored as JSON (see DESIGN.md)::
+A world is stored as JSON::
 
     {"name": "office", "walls": [[x1, y1, x2, y2], ...], "route": [[x, y], ...],
      "start": [x, y, theta]}
@@ -498,7 +498,7 @@ def campus_world() -> World:
     the middle corridor again, and east along the south corridor as at the start. Coming
     down the middle corridor onto the south one, the robot looks along a corridor it drove
     430 m earlier facing the other way: the two views overlap little, and most where the
-    corridors cross (README, *Not solved: long corridors*).
+    corridors cross.
     """
     w, h, c = 200.0, 120.0, 2.5
     m, x = c / 2, w / 2

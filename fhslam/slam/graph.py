@@ -3,7 +3,7 @@
 On a simulated world the paper's step-by-step calibration keeps the pose within centimetres
 (:mod:`fhslam.slam.fht`). Real logs need more: odometry that glitches (a 85° heading jump
 between two scans), rooms visited again after hundreds of metres, clutter that no straight
-line describes. What this module adds, each measured in the README:
+line describes. What this module adds, each measured (see :class:`GraphSlamParams`):
 
 1. **Scan-to-map tracking** (:mod:`fhslam.slam.tracker`): every scan is placed against the
    points of the last ``submap_keyframes`` keyframes by an exhaustive correlative search
@@ -122,19 +122,21 @@ class GraphSlamParams:
     smooth_clouds : bool
         Move each scan's points onto the line of their seven beam neighbours
         (:func:`fhslam.scanmatch.smooth_scan`, straight surfaces only) before they enter a
-        keyframe's cloud, so that the range noise across a wall is averaged out of the map
-        the scans are tracked against (not out of the scans themselves). It cuts the
-        tracker's heading drift along straight corridors severalfold (96 m of the
-        ``campus``'s corridor with perfect odometry and the simulator's 1 cm of range noise,
-        seeds 0-3: 2.3-2.8 degrees and 1.9-2.4 m sideways at its end without, 0.5-0.86
-        degrees and 0.45-0.6 m with it; the ``ring``'s first straight 0.8-1.25 degrees,
-        -0.03 to 0.48 with it). Added at stop 34, off until stop 43: the Freiburg hospital's
-        return failed with it in 4 of 33 perturbed runs (3 without) until
-        ``global_consistency`` (stop 40), and the harsh pillared hall came out at 5.77 cm
-        (0.82 without) until ``loop_unique_radius`` (stop 41). With both, the default since
-        stop 43: all 32 perturbed hospital runs within issue 10's bound (31 before), the
-        five shared logs within 1.5 %, the README's 120-run yardstick at a mean of 1.11 cm
-        (1.25 before; README, *Stops 41-43*).
+        keyframe's cloud, so that the range noise across a wall is averaged out of the map the scans
+        are tracked against (not out of the scans themselves). It cuts the tracker's heading drift
+        along straight corridors severalfold (96 m of the ``campus``'s corridor with perfect
+        odometry and the simulator's 1 cm of range noise, seeds 0-3: 2.3-2.8 degrees and 1.9-2.4 m
+        sideways at its end without, 0.5-0.86 degrees and 0.45-0.6 m with it; the ``ring``'s first
+        straight 0.8-1.25 degrees, -0.03 to 0.48 with it). It needs ``global_consistency`` and
+        ``loop_unique_radius``: with ``global_consistency`` at the local closures' 0.15 m the
+        Freiburg hospital's return failed with it in 4 of 33 perturbed runs (3 without it), and
+        without ``loop_unique_radius`` the harsh pillared hall came out at 5.77 cm (0.82 without
+        it). With both, the default: all 32 perturbed hospital runs within the robustness bound (31
+        with neither it nor ``loop_unique_radius``), the five shared logs within 1.5 %, and the
+        120-run simulated yardstick (the ``paper``, ``offices``, ``hall``, ``corridor``,
+        ``random:109`` and ``random:105`` worlds, seeds 0-4, clean and with 1 mm of range noise and
+        10 % of the scans dropped, each also with its odometry perturbed in the last bit) at a mean
+        of 1.11 cm (1.25 with neither).
     corner_deg : float
         The points filled in between two beams (:func:`fhslam.scanmatch.densify`) across
         a chord that turns by more than this from both neighbouring chords, degrees, get
@@ -144,9 +146,9 @@ class GraphSlamParams:
         (tracking, pairs, loop closures) leave them out (the tracker's fallback against the
         previous scan, filled in as it goes, keeps them). 0, the default: every filled
         point keeps its chord's normal. Along the ``ring``'s corridors 20 takes most of the
-        tracker's forward push out (the scale 0.20-0.24 % large -> 0.01-0.09 %), but the
-        README's yardstick and two of the shared logs lose, and the Freiburg hospital's
-        return is missed in 22 of its 30 perturbed runs (README, stop 49).
+        tracker's forward push out (the scale 0.20-0.24 % large -> 0.01-0.09 %), but the simulated
+        yardstick and two of the shared logs lose, and the Freiburg hospital's return is missed in
+        22 of its 30 perturbed runs.
     submap_keyframes : int
         Keyframes in the local map a scan is tracked against.
     max_doubtful : int
@@ -173,24 +175,23 @@ class GraphSlamParams:
         the other way round, the push is backwards, and somewhat larger (the 180° laser
         looks ahead in both clouds): with the tracker's edge the two balance it, measured,
         not derived: the ``ring`` (2 laps, seeds 0-3) 9.3, 10.9, 9.8, 9.6 cm -> 3.0, 1.8,
-        5.8, 10.1 cm, its scale within 0.034 % (seed 3's error is a turn). Added at stop 47,
-        off by default: the shared logs and the Freiburg hospital's 32 perturbed runs hold
-        with it, but the paper world loses (3 of the 120 simulated yardstick runs over 3 cm,
-        none without; README, *Not solved: long corridors*). Each edge carries all of its
-        information, unless ``pair_share``.
+        5.8, 10.1 cm, its scale within 0.034 % (seed 3's error is a turn). Off by default: the
+        shared logs and the Freiburg hospital's 32 perturbed runs hold with it, but the paper world
+        loses (3 of the 120 simulated yardstick runs over 3 cm, none without). Each edge carries all
+        of its information, unless ``pair_share``.
     pair_share : bool
         With ``pair_edges``: the tracker's edge and the pair edges made for the same two
         keyframes share the scans' information about the translation instead of each
         carrying all of it (they come from the same scans): with both pair edges, each of
         the three carries a third (the tracker's edge its odometry prior and heading in
         full), so that the graph weighs the scans against the loop closures as without
-        pairs. Stop 48: the paper world's pairs repeat the tracker's errors where the scans
-        mislead (after a turn, 2-5 cm at a few keyframes), and counted three times those
-        outweighed the loop closures; shared, the README's 120-run yardstick has 1 run over
-        3 cm (3 unshared, none without pairs) at a mean of 0.999 cm (1.082 unshared, 1.015
-        without), the ``ring`` (seeds 0-3) 3.6, 3.6, 2.9, 7.5 cm; but the Freiburg
-        hospital's dropped-scans seed 11 misses its return (2.09 m; the other 13 and the 16
-        runs with 1 mm of noise hold; unshared all 32 hold). Off by default.
+        pairs. The paper world's pairs repeat the tracker's errors where the scans mislead (after a
+        turn, 2-5 cm at a few keyframes), and counted three times those outweighed the loop
+        closures; shared, the 120-run simulated yardstick has 1 run over 3 cm (3 unshared, none
+        without pairs) at a mean of 0.999 cm (1.082 unshared, 1.015 without), the ``ring`` (seeds
+        0-3) 3.6, 3.6, 2.9, 7.5 cm; but the Freiburg hospital's dropped-scans seed 11 misses its
+        return (2.09 m; the other 13 and the 16 runs with 1 mm of noise hold; unshared all 32 hold).
+        Off by default.
     loop_radius : float
         Old keyframes that looked within this distance of where the keyframe looks are loop
         candidates (where a keyframe looks: the mean of its cloud, placed at the current
@@ -207,17 +208,15 @@ class GraphSlamParams:
         j + loop_target_keyframes`` (none within ``loop_min_gap`` of the query), about 6 m
         of travel at 6. It should cover what the query sees: a query that overlaps its
         target only in part can score higher shifted along a corridor, so that more of it
-        falls on the target's walls. On the ``campus`` (README, *Not solved: long
-        corridors*), coming down one corridor onto another it had driven before, the
-        queries matched ± 3 keyframes 2.5 m off (the crossing corridor's width; 0.72
-        against 0.55 at the true pose) and every later closure inherited the shift. With
-        ± 6 (stop 44; the default since then), seeds 0-4 give 0.33, 0.46, 0.47, 5.64 and
-        0.45 m (± 3: 7.78, 0.38, 7.60, 6.83, 0.34 m): not a cure, both hypotheses can
-        still score alike. The Freiburg hospital's 32 perturbed runs (noise, dropped scans,
-        both) all stay within issue 10's bound (as with ± 3; at stop 35, before the global
-        search's consistency test, ± 6 failed 6 of 33), the README's 120-run yardstick comes to a
-        mean of 1.05 cm with 2 runs over 3 cm (± 3: 1.11 cm, 5), and the shared logs
-        within 1 %.
+        falls on the target's walls. On the ``campus``, coming down one corridor onto another it
+        had driven before, the queries matched ± 3 keyframes 2.5 m off (the crossing corridor's
+        width; 0.72 against 0.55 at the true pose) and every later closure inherited the shift.
+        With ± 6 (the default), seeds 0-4 give 0.33, 0.46, 0.47, 5.64 and 0.45 m (± 3: 7.78,
+        0.38, 7.60, 6.83, 0.34 m): not a cure, both hypotheses can still score alike. The
+        Freiburg hospital's 32 perturbed runs (noise, dropped scans, both) all stay within the
+        robustness bound (as with ± 3; without the global search's consistency test, ± 6 failed
+        6 of 33), the 120-run simulated yardstick comes to a mean of 1.05 cm with 2 runs over 3
+        cm (± 3: 1.11 cm, 5), and the shared logs within 1 %.
     loop_candidates : int
         Nearest candidates tried per keyframe. Chosen by where the keyframes stood instead
         of where they looked, a corridor driven back the other way (the ``offices`` world)
@@ -282,17 +281,17 @@ class GraphSlamParams:
         and 0.72, 3.5 m off): a closure against the same target is no independent
         evidence.
     loop_unique_radius : float
-        ... and a closure that would move it less is added at once only if its match is
-        unique: nothing farther than this (metres, in x or y) from the match scores within
+        ... and a closure that would move it less is added at once only if its match is unique:
+        nothing farther than this (metres, in x or y) from the match scores within
         ``global_max_ambiguity`` of it (:attr:`fhslam.scanmatch.MatchResult.runner_up`);
-        otherwise it is held as above. 0 leaves the test out. Added at stop 41 for
-        ``smooth_clouds``, 0.3 by default with it since stop 43: the harsh pillared hall
-        (``hall`` seed 0, 1 mm of range noise, 10 % of the scans dropped) comes back to its
-        start, where its last keyframe matches the first ones along the pillar rows 11 cm,
-        78 cm and (without ``smooth_clouds``) 159 cm off, refined each to a residual under
-        1 cm. Without ``smooth_clouds`` the nearest of those moves the keyframe more than
-        0.1 m and waits; with it 11 cm off moves it less and, without this test, enters the
-        graph unconfirmed and bends the run to an ATE of 5.77 cm (0.95 cm with it).
+        otherwise it is held as above. 0 leaves the test out. ``smooth_clouds`` needs it (0.3,
+        the default): the harsh pillared hall (``hall`` seed 0, 1 mm of range noise, 10 % of the
+        scans dropped) comes back to its start, where its last keyframe matches the first ones
+        along the pillar rows 11 cm, 78 cm and (without ``smooth_clouds``) 159 cm off, refined
+        each to a residual under 1 cm. Without ``smooth_clouds`` the nearest of those moves the
+        keyframe more than 0.1 m and waits; with it 11 cm off moves it less and, without this
+        test, enters the graph unconfirmed and bends the run to an ATE of 5.77 cm (0.95 cm with
+        it).
     loop_consistency : float
         See ``loop_confirm_deg``.
     loop_consistency_deg : float
@@ -300,7 +299,7 @@ class GraphSlamParams:
     loop_confirm_window : int
         See ``loop_confirm_deg``.
     loop_repeat_confirm : float
-        0 leaves this out. Above 0 (0.02, the default since stop 46), a held closure whose
+        0 leaves this out. Above 0 (0.02, the default), a held closure whose
         match is unique (see ``loop_unique_radius``) and that moves its keyframe by at most
         three times ``loop_confirm_distance`` is also confirmed by another such closure from
         another keyframe's query, against the same target or not, when the two place the
@@ -313,7 +312,7 @@ class GraphSlamParams:
         apart) and it ends at 1.51 cm. Without the bound on the move, wrong matches that
         repeat as alike confirm each other: the ``ring``'s a corridor's width off (seeds
         0-3: 2.99-3.16 m instead of 0.10-0.12) and the ``campus``'s 2.5 m off (seed 2:
-        0.47 -> 6.87 m). Stop 45 (README, *Not solved: long corridors*).
+        0.47 -> 6.87 m).
     global_every : int
         Once the robot has travelled ``global_after`` metres since the last closure, every
         this many keyframes a *global* search runs (0: never): the last
@@ -336,21 +335,21 @@ class GraphSlamParams:
         The Freiburg hospital comes back to its start after 900 m without a closure, its
         estimate 17-39 m and 12-25 degrees off (85-146 m and 25-40 degrees with 1 mm of
         range noise or scans dropped): its global matches there score 0.6-0.7, and the
-        relation error falls from 1.13 m to 0.127 m (README, the hospital's section).
+        relation error falls from 1.13 m to 0.127 m.
     global_after : float
         See ``global_every``: metres of travel without a closure before the global search
-        starts (around the odometry's guess). Until stop 31 it waited until the local
-        search's radius was at its largest (110 m), and looked around the estimate only:
-        the hospital's return was found with its unperturbed ranges only.
+        starts (around the odometry's guess). Waiting until the local search's radius is at its
+        largest (110 m) and looking around the estimate only, the hospital's return was found
+        with its unperturbed ranges only.
     global_from_odometry : bool
         See ``global_every``.
     global_keyframes : int
         See ``global_every``.
     global_min_score : float
         See ``global_every``: the score a global match needs to be held as a hypothesis.
-        0.6 until stop 38, when the hospital's return scored 0.58-0.66 where it was found
-        (README, the hospital's section): with 0.6 and no ``global_confirm_score`` below it
-        its dropped-scans runs failed in 4 of 14 (seeds 3, 11, 12, 13), with 0.55 and 0.5 in 1.
+        The hospital's return scores 0.58-0.66 where it is found: with 0.6 and no
+        ``global_confirm_score`` below it its dropped-scans runs failed in 4 of 14 (seeds 3, 11,
+        12, 13), with 0.55 and 0.5 in 1.
     global_confirm_score : float
         See ``global_every``: the score the match that confirms a hypothesis needs (never
         more than ``global_min_score``; it must also be unique and agree with the hypothesis,
@@ -383,9 +382,9 @@ class GraphSlamParams:
         tracker may have bent; the Freiburg hospital's right confirmations at its return
         after 900 m lie up to 0.22 m and 1.5 degrees apart, its other confirmations within
         0.06 m and 0.5 degrees, and a wrong match is metres away (the ``ring``'s period
-        of 10 m, the ``campus``'s crossing of 2.5 m). Until stop 40 the local closures' 0.15 m
-        and 2 degrees: the hospital's dropped-scans seed 9 with ``smooth_clouds`` (0.159
-        m) and dropped scans and noise seed 0 likewise (0.186 m) missed their return.
+        of 10 m, the ``campus``'s crossing of 2.5 m). With the local closures' 0.15 m and 2
+        degrees, the hospital's dropped-scans seed 9 with ``smooth_clouds`` (0.159 m) and
+        dropped scans and noise seed 0 likewise (0.186 m) missed their return.
     global_consistency_deg : float
         See ``global_consistency``: how far in heading, degrees.
     inner_closures_reset : bool
@@ -393,14 +392,14 @@ class GraphSlamParams:
         travel since the last closure; the local search's radius and the global search
         count from where it began. A closure whose old keyframe lies ``global_after``
         metres or more into that same stretch ties the robot to a place as lost as itself:
-        since stop 39 (False) the stretch goes on, unless one of the keyframe's closures
-        reaches further back. Before (True), it ended it and with it the global search, and
-        a hypothesis that search held was never confirmed: the Freiburg hospital's return
-        with loop targets of ± 6 keyframes for turned candidates (README, stop 39) failed
-        twice so: dropped-scans seed 1 (a closure of scans 6026/5955 between a hypothesis
-        at scan 6005 and its confirmation) 3.73 m, 0.130 m with the stretch going on; noise
-        seed 13 0.98 m, 0.121 m. With the default targets no hospital run changes its
-        outcome; MIT CSAIL and Freiburg 079 each make 2 global closures (none before).
+        with False (the default) the stretch goes on, unless one of the keyframe's closures
+        reaches further back. With True it ends it and with it the global search, and a
+        hypothesis that search held is never confirmed: the Freiburg hospital's return with loop
+        targets of ± 6 keyframes for turned candidates failed twice so: dropped-scans seed 1 (a
+        closure of scans 6026/5955 between a hypothesis at scan 6005 and its confirmation) 3.73
+        m, 0.130 m with the stretch going on; noise seed 13 0.98 m, 0.121 m. With the default
+        targets no hospital run changes its outcome; MIT CSAIL and Freiburg 079 each make 2
+        global closures with False (none with True).
     optimize_iterations : int
         Largest number of Gauss-Newton rounds after a keyframe that closed a loop...
     optimize_tol : float

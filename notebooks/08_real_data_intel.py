@@ -627,5 +627,5 @@ timing_table(
 # - All five shared logs (these two, aces, fr079, fr-clinic) were used in development; logs
 #   nobody here has seen are the real test of the defaults. The README has all five: all meet
 #   their relation-error limits as logged (the Freiburg hospital's return to its start, 900 m after its
-#   last loop closure, only through a global loop search), but the hospital not with 1 mm of
-#   range noise or dropped scans.
+#   last loop closure, only through a global loop search), also with 1 mm of range noise or
+#   10 % of the scans dropped.

@@ -1073,9 +1073,11 @@ def _run_notebooks(args: argparse.Namespace) -> None:
         args.in_progress = path  # named by main() if interrupted: left as it was
         if args.pair_only:
             py = paired_path(path)
-            before = py.read_text() if py.exists() else None
+            before = py.read_text(encoding="utf-8") if py.is_file() else None
             pair(path)  # writes the .py only where it differs
-            print(f"{py}: {'up to date' if py.read_text() == before else 'written'}")
+            print(
+                f"{py}: {'up to date' if py.read_text(encoding='utf-8') == before else 'written'}"
+            )
         else:
             print(run_notebook(path, timeout=args.timeout), flush=True)
     args.in_progress = None

@@ -219,6 +219,13 @@ def _comparable(nb) -> str:
     return nbformat.writes(nb)
 
 
+def _text_of(path: Path) -> str:
+    """The text of the file ``path`` (an :class:`~fhslam.errors.InputError` naming it if it
+    cannot be read)."""
+    with reading(path):
+        return path.read_text(encoding="utf-8")
+
+
 def _write(nb, path: Path) -> bool:
     """Write notebook ``nb`` to ``path`` and its paired ``.py`` beside it, each only where it
     differs from the file there: the notebook not at all if it differs only in what a run
@@ -230,7 +237,7 @@ def _write(nb, path: Path) -> bool:
     py = paired_path(path)
     old = _read(path) if path.exists() else None
     write_nb = old is None or _comparable(old) != _comparable(nb)
-    write_py = not py.exists() or py.read_text() != text
+    write_py = not py.is_file() or _text_of(py) != text  # not a file: its write says why
     with output_batch():  # the notebook and its .py together, or neither
         if write_nb:
             with atomic_output(path) as f:

@@ -611,23 +611,18 @@ class _Gunzipped(gzip.GzipFile):
         self._path, self._raw = path, raw
 
     def read(self, size: int = -1) -> bytes:
-        try:
-            return super().read(size)
-        except (EOFError, OSError, zlib.error) as e:
-            where = self._raw.tell()
-            raise CarmenFormatError(
-                f"{self._path}: damaged gzip data at about byte {where} of the compressed "
-                f"file ({e}); the log cannot be read past it"
-            ) from None
+        return self._named(super().read, size)
 
     def read1(self, size: int = -1) -> bytes:
+        return self._named(super().read1, size)
+
+    def _named(self, read, size: int) -> bytes:
         try:
-            return super().read1(size)
+            return read(size)
         except (EOFError, OSError, zlib.error) as e:
-            where = self._raw.tell()
             raise CarmenFormatError(
-                f"{self._path}: damaged gzip data at about byte {where} of the compressed "
-                f"file ({e}); the log cannot be read past it"
+                f"{self._path}: damaged gzip data at about byte {self._raw.tell()} of the "
+                f"compressed file ({e}); the log cannot be read past it"
             ) from None
 
 

@@ -28,7 +28,7 @@ from pathlib import Path
 
 __all__ = ["CACHE_DIR", "CACHING", "CacheWarning", "intrinsic", "njit", "types"]
 
-KERNEL_FOLDERS = (Path(__file__).parent, Path(__file__).parent / "extraction")
+KERNEL_FOLDERS = tuple(Path(__file__).parent / d for d in ("", "extraction", "scanmatch"))
 """The package's folders with compiled kernels: numba caches them in their ``__pycache__``."""
 
 

@@ -247,7 +247,7 @@ def test_branch_and_bound_finds_exactly_the_exhaustive_optimum(prior):
     """Branch and bound over max-pooled grids returns the exhaustive search's pose and score
     bit for bit, ties included (a room seen from many poses; a query off the grid, where
     every shift scores 0)."""
-    from fhslam.scanmatch import _search, _search_bnb
+    from fhslam.scanmatch.search import _search, _search_bnb
 
     rng = np.random.default_rng(7)
     room = _room()

@@ -191,6 +191,135 @@ def inliers_kernel(p, rho, theta, tol, out):
 
 
 @njit(**_JIT)
+def refine_kernel(pts, alive, inl, rho, theta, tol, refine_iterations):
+    """Inliers of the line ``(rho, theta)`` among the remaining scan points (``alive``), written
+    into ``inl``, with the line refitted to them by least squares ``refine_iterations`` times.
+    Returns the refined ``(rho, theta)``."""
+    for _it in range(refine_iterations + 1):
+        inliers_kernel(pts, rho, theta, tol, inl)
+        inl &= alive
+        if _it == refine_iterations:
+            break
+        r2, t2, k = tls_kernel(pts, inl, theta)
+        if k < 2 or np.isnan(r2):
+            break
+        rho, theta = r2, t2
+    return rho, theta
+
+
+@njit(**_JIT)
+def peak_line_kernel(
+    pts, vp, hist, alive, inl, n_bins, half, dtheta, rho_step, tol, refine_iterations,
+    min_points, max_peaks,
+):  # fmt: skip
+    """The line of the histogram's maximum, else of its sub-maxima: a slope voted by pairs
+    across two walls may hold no line while the next peak does. Each peak tried without a
+    line of ``min_points`` inliers is suppressed in ``hist`` with its window.
+
+    Returns ``(rho, theta, n_inl)``, the last line tried and its inlier count; ``inl`` holds
+    its inliers among the scan points ``pts``.
+    """
+    m = pts.shape[0]
+    rho, theta = 0.0, 0.0
+    n_inl = 0
+    for _peak in range(max_peaks):
+        phi, support = dominant_kernel(hist)
+        if support <= 0:
+            break
+        rho, theta = window_hough_kernel(vp, phi, half, dtheta, rho_step)[:2]
+        rho, theta = refine_kernel(pts, alive, inl, rho, theta, tol, refine_iterations)
+        n_inl = 0
+        for i in range(m):
+            n_inl += inl[i]
+        if n_inl >= min_points:
+            break
+        k_peak = int(phi * n_bins / np.pi)  # suppress this peak and its window
+        w_bins = max(1, int(np.ceil(half * dtheta * n_bins / np.pi)))
+        for b in range(k_peak - w_bins, k_peak + w_bins + 1):
+            hist[b % n_bins] = 0
+    return rho, theta, n_inl
+
+
+@njit(**_JIT)
+def runs_kernel(pts, inl, theta, gap, base, min_points, min_length, seg, offsets, flat, n_seg):
+    """Split the line's inliers ``inl`` at gaps wider than ``gap`` and append each run long
+    enough as a segment (:func:`emit_kernel`). Returns the new segment count."""
+    m = pts.shape[0]
+    run_start = -1
+    last = -1
+    for i in range(m + 1):
+        is_in = i < m and inl[i]
+        cut = not is_in
+        if is_in and last >= 0:
+            dx = pts[i, 0] - pts[last, 0]
+            dy = pts[i, 1] - pts[last, 1]
+            cut = dx * dx + dy * dy > gap * gap
+        if cut and run_start >= 0:
+            n_seg = emit_kernel(
+                pts,
+                inl,
+                run_start,
+                last,
+                theta,
+                base,
+                min_points,
+                min_length,
+                seg,
+                offsets,
+                flat,
+                n_seg,
+            )
+            run_start = -1
+        if is_in:
+            if run_start < 0:
+                run_start = i
+            last = i
+    return n_seg
+
+
+@njit(**_JIT)
+def cluster_lines_kernel(
+    pts, base, u, gap, dense_step, n_bins, min_pair_dist, all_pairs, half, dtheta, rho_step,
+    tol, refine_iterations, min_points, min_length, max_rounds, max_peaks, seg, offsets, flat,
+    n_seg,
+):  # fmt: skip
+    """The lines of one cluster ``pts`` (scan points ``base`` on), round after round on the
+    points no line took yet, appended to ``seg``, ``offsets`` and ``flat``. Returns the new
+    segment count."""
+    m = pts.shape[0]
+    votes, _src = densify_kernel(pts, dense_step)
+    alive = np.ones(m, np.bool_)
+    valive = np.ones(votes.shape[0], np.bool_)
+    inl = np.zeros(m, np.bool_)
+    vinl = np.zeros(votes.shape[0], np.bool_)
+    n_alive = m
+    for _round in range(max_rounds):
+        vp = votes[valive]
+        if vp.shape[0] < 2:
+            break
+        hist = slope_histogram_kernel(vp, u, n_bins, min_pair_dist, all_pairs)
+        rho, theta, n_inl = peak_line_kernel(
+            pts, vp, hist, alive, inl, n_bins, half, dtheta, rho_step, tol, refine_iterations,
+            min_points, max_peaks,
+        )  # fmt: skip
+        if n_inl < min_points:
+            break  # support under the threshold at every peak: this cluster is done
+        # Split the line's inliers at gaps; keep long-enough runs as segments.
+        n_seg = runs_kernel(
+            pts, inl, theta, gap, base, min_points, min_length, seg, offsets, flat, n_seg
+        )
+        for i in range(m):
+            if inl[i]:
+                alive[i] = False
+                n_alive -= 1
+        inliers_kernel(votes, rho, theta, tol, vinl)
+        valive &= ~vinl
+        if n_alive < min_points:
+            break
+    return n_seg
+
+
+@njit(**_JIT)
 def extract_kernel(
     p,
     u,
@@ -209,7 +338,8 @@ def extract_kernel(
     max_rounds,
     max_peaks,
 ):
-    """The whole of Loop 1 for one scan.
+    """The whole of Loop 1 for one scan: the lines of each cluster of at least ``min_points``
+    points (:func:`cluster_lines_kernel`).
 
     Returns per segment ``(rho, theta, rms, sp_x, sp_y, ep_x, ep_y)`` in the paper's form and
     its inlier indices (``flat[offsets[k]:offsets[k + 1]]``).
@@ -225,87 +355,12 @@ def extract_kernel(
         stop = start
         while stop < n and labels[stop] == labels[start]:
             stop += 1
-        m = stop - start
-        if m >= min_points:
-            pts = p[start:stop]
-            votes, _src = densify_kernel(pts, dense_step)
-            alive = np.ones(m, np.bool_)
-            valive = np.ones(votes.shape[0], np.bool_)
-            inl = np.zeros(m, np.bool_)
-            vinl = np.zeros(votes.shape[0], np.bool_)
-            n_alive = m
-            for _round in range(max_rounds):
-                vp = votes[valive]
-                if vp.shape[0] < 2:
-                    break
-                hist = slope_histogram_kernel(vp, u, n_bins, min_pair_dist, all_pairs)
-                # The maximum of the histogram, else its sub-maxima: a slope voted by pairs
-                # across two walls may hold no line while the next peak does.
-                n_inl = 0
-                for _peak in range(max_peaks):
-                    phi, support = dominant_kernel(hist)
-                    if support <= 0:
-                        break
-                    rho, theta = window_hough_kernel(vp, phi, half, dtheta, rho_step)[:2]
-                    # Inliers among the remaining scan points, refined by least squares.
-                    for _it in range(refine_iterations + 1):
-                        inliers_kernel(pts, rho, theta, tol, inl)
-                        inl &= alive
-                        if _it == refine_iterations:
-                            break
-                        r2, t2, k = tls_kernel(pts, inl, theta)
-                        if k < 2 or np.isnan(r2):
-                            break
-                        rho, theta = r2, t2
-                    n_inl = 0
-                    for i in range(m):
-                        n_inl += inl[i]
-                    if n_inl >= min_points:
-                        break
-                    k_peak = int(phi * n_bins / np.pi)  # suppress this peak and its window
-                    w_bins = max(1, int(np.ceil(half * dtheta * n_bins / np.pi)))
-                    for b in range(k_peak - w_bins, k_peak + w_bins + 1):
-                        hist[b % n_bins] = 0
-                if n_inl < min_points:
-                    break  # support under the threshold at every peak: this cluster is done
-                # Split the line's inliers at gaps; keep long-enough runs as segments.
-                run_start = -1
-                last = -1
-                for i in range(m + 1):
-                    is_in = i < m and inl[i]
-                    cut = not is_in
-                    if is_in and last >= 0:
-                        dx = pts[i, 0] - pts[last, 0]
-                        dy = pts[i, 1] - pts[last, 1]
-                        cut = dx * dx + dy * dy > gap * gap
-                    if cut and run_start >= 0:
-                        n_seg = emit_kernel(
-                            pts,
-                            inl,
-                            run_start,
-                            last,
-                            theta,
-                            start,
-                            min_points,
-                            min_length,
-                            seg,
-                            offsets,
-                            flat,
-                            n_seg,
-                        )
-                        run_start = -1
-                    if is_in:
-                        if run_start < 0:
-                            run_start = i
-                        last = i
-                for i in range(m):
-                    if inl[i]:
-                        alive[i] = False
-                        n_alive -= 1
-                inliers_kernel(votes, rho, theta, tol, vinl)
-                valive &= ~vinl
-                if n_alive < min_points:
-                    break
+        if stop - start >= min_points:
+            n_seg = cluster_lines_kernel(
+                p[start:stop], start, u, gap, dense_step, n_bins, min_pair_dist, all_pairs,
+                half, dtheta, rho_step, tol, refine_iterations, min_points, min_length,
+                max_rounds, max_peaks, seg, offsets, flat, n_seg,
+            )  # fmt: skip
         start = stop
     return seg[:n_seg], offsets[: n_seg + 1], flat[: offsets[n_seg]]
 

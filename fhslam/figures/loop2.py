@@ -17,20 +17,17 @@ from fhslam.figures.scenes import (
 from fhslam.matching import MatchParams, Similarity, merge, similarity
 
 
-def fig06_line_attributes() -> Figure:
-    """Fig. 6: the attributes (ρ, θ, n, l, sp, ep, dir, d) of a feature line AB and a robot."""
-    line, pose = line_attributes_example()
-    pts = _fig06_points()
-    nrm, u = line.normal, np.array([-line.normal[1], line.normal[0]])
-    P = line.rho * nrm
-    x, y, _ = pose
-    foot = np.array([x, y]) + line.d * nrm
-    fig, ax = plt.subplots(figsize=(10, 7.5))
+def _fig06_axes(ax) -> None:
+    """The x and y axes through the origin, as arrows."""
     ax.annotate("", (4.3, 0), (-0.6, 0), arrowprops={"arrowstyle": "-|>", "color": "0.5"})
     ax.annotate("", (0, 3.55), (0, -0.5), arrowprops={"arrowstyle": "-|>", "color": "0.5"})
     ax.text(4.3, -0.12, "x", ha="right", va="top", color="0.4")
     ax.text(-0.08, 3.55, "y", ha="right", va="top", color="0.4")
-    # the infinite line, the segment AB and its points
+
+
+def _fig06_segment(ax, line, pts, P, u) -> None:
+    """The infinite line through P (direction ``u``), the segment AB, its points and its
+    length l."""
     far = P + np.array([-2.2, 2.6])[:, None] * u
     ax.plot(*far.T, ":", color=plotting.LINE_COLOR, lw=1)
     plotting.plot_lines([line], ax=ax, label="feature line AB")
@@ -43,7 +40,10 @@ def fig06_line_attributes() -> Figure:
     plotting.plot_dimension(
         line.sp, line.ep, ax=ax, label=f"l = {line.length:.2f} m", offset=-0.3, text_offset=0.13
     )
-    # O, P, rho and theta
+
+
+def _fig06_rho_theta(ax, line, P, nrm, u) -> None:
+    """O, the foot P of the normal from O, rho and theta."""
     ax.plot(*np.c_[[0.0, 0.0], P], "k--", lw=1.2)
     ax.plot(0, 0, "ko", ms=4)
     ax.annotate("O", (0, 0), xytext=(-13, -14), textcoords="offset points", fontsize=12)
@@ -61,7 +61,12 @@ def fig06_line_attributes() -> Figure:
         (0, 0), 0.55, 0.0, line.theta, ax=ax, label=rf"$\theta$ = {np.degrees(line.theta):.1f}°",
         label_radius=0.95,
     )  # fmt: skip
-    # the robot, d and dir
+
+
+def _fig06_robot(ax, line, pose, nrm, u) -> None:
+    """The robot, its distance d to the line (to the foot of its normal) and dir."""
+    x, y, _ = pose
+    foot = np.array([x, y]) + line.d * nrm
     plotting.plot_robot(pose, ax=ax, size=0.3)
     ax.annotate(
         f"robot (x, y, φ) = ({x:.2f}, {y:.2f}, {np.degrees(pose[2]):.0f}°)",
@@ -81,8 +86,13 @@ def fig06_line_attributes() -> Figure:
         va="bottom",
         color="darkgreen",
     )
+
+
+def _fig06_attributes_text(line, pose) -> str:
+    """The box of the line's attributes as observed from ``pose``, and how dir is worked out."""
+    x, y, _ = pose
     s = line.rho - x * np.cos(line.theta) - y * np.sin(line.theta)
-    box = "\n".join(
+    return "\n".join(
         [
             "Line.observed_from(pose):",
             rf"  $\rho$  = {line.rho:.3f} m",
@@ -101,9 +111,22 @@ def fig06_line_attributes() -> Figure:
             "(robot on the origin's side of AB)",
         ]
     )
+
+
+def fig06_line_attributes() -> Figure:
+    """Fig. 6: the attributes (ρ, θ, n, l, sp, ep, dir, d) of a feature line AB and a robot."""
+    line, pose = line_attributes_example()
+    pts = _fig06_points()
+    nrm, u = line.normal, np.array([-line.normal[1], line.normal[0]])
+    P = line.rho * nrm
+    fig, ax = plt.subplots(figsize=(10, 7.5))
+    _fig06_axes(ax)
+    _fig06_segment(ax, line, pts, P, u)
+    _fig06_rho_theta(ax, line, P, nrm, u)
+    _fig06_robot(ax, line, pose, nrm, u)
     ax.text(
-        0.985, 0.97, box, transform=ax.transAxes, ha="right", va="top", fontsize=10,
-        multialignment="left",
+        0.985, 0.97, _fig06_attributes_text(line, pose), transform=ax.transAxes, ha="right",
+        va="top", fontsize=10, multialignment="left",
         bbox={"boxstyle": "round", "facecolor": "white", "edgecolor": "0.6"},
     )  # fmt: skip
     ax.set_aspect("equal", adjustable="box")

@@ -92,395 +92,62 @@ A ``PARAM`` of one of these five names without a value, with a non-numeric or no
 value, with an angle out of range (a resolution or field of view outside (0°, 360°], an
 angular offset beyond ±2π, i.e. given in degrees), or stated twice with different values
 is a :class:`CarmenFormatError`; every other ``PARAM`` (many hold strings) is ignored.
+
+The reader is this module (:func:`read_carmen`, and the rules above for the mount, the
+bearings and the maximum range); the line reader, the line parsers, the writer and the
+conventions they share are modules of their own (:mod:`fhslam.io.carmen_lines`,
+:mod:`fhslam.io.carmen_parse`, :mod:`fhslam.io.carmen_write`,
+:mod:`fhslam.io.carmen_format`), their public names importable from here too.
 """
 
 from __future__ import annotations
 
-import codecs
-import gzip
-import io
 import math
 import warnings
-import zlib
-from collections.abc import Iterator
 from dataclasses import dataclass, field
 from os import PathLike
 from pathlib import Path
-from typing import IO
 
 import numpy as np
 from numpy.typing import NDArray
 
-from fhslam.errors import InputError, InputWarning
-from fhslam.geometry import compose, relative, wrap_angle
-from fhslam.io.files import atomic_output, input_path, reading
-from fhslam.io.log import (
-    Log,
-    check_readings,
-    check_sequence,
-    effective_max_range,
-    is_number,
-    stated_range_problem,
+from fhslam.geometry import relative, wrap_angle
+from fhslam.io.carmen_format import (
+    FOV_PARAM,
+    MOUNT_PARAMS,
+    RESOLUTION_PARAM,
+    CarmenFormatError,
+    CarmenWarning,
+    flaser_angles,
 )
+from fhslam.io.carmen_lines import MAX_LINE, _text_lines, _Unreadable
+from fhslam.io.carmen_parse import _PARSERS, _Param, _Parsed, _read_param
+from fhslam.io.carmen_write import HOSTNAME, write_carmen
+from fhslam.io.files import input_path, reading
+from fhslam.io.log import Log, check_readings, check_sequence, effective_max_range
 
-HOSTNAME = "fhslam"
+__all__ = [
+    "FLASER_MAX_RANGE",
+    "FOV_PARAM",
+    "HOSTNAME",
+    "MAX_LINE",
+    "MOUNT_PARAMS",
+    "MOUNT_TOLERANCE",
+    "RESOLUTION_PARAM",
+    "CarmenFormatError",
+    "CarmenWarning",
+    "flaser_angles",
+    "read_carmen",
+    "write_carmen",
+]
+
 FLASER_MAX_RANGE = 80.0
 """CARMEN's assumed maximum range of an old ``FLASER`` laser, metres."""
-
-
-class CarmenFormatError(InputError):
-    """A malformed CARMEN log. The message reads ``"{path}:{lineno}: {what is wrong}"``."""
-
-
-class CarmenWarning(InputWarning):
-    """A CARMEN log that contradicts itself, e.g. a ``PARAM`` mount its laser poses disagree
-    with (the reader goes on with the rule of the module docstring)."""
-
 
 MOUNT_TOLERANCE = (1e-3, 1e-3)
 """How far (metres, radians) the laser-pose offsets of a log may scatter and still count as
 one constant mount, and how far the ``PARAM`` mount and that offset may differ and still
 agree. CARMEN prints poses to 1e-6 (``%f``), a thousandth of this."""
-
-MOUNT_PARAMS = (
-    "robot_frontlaser_offset",
-    "robot_frontlaser_side_offset",
-    "robot_frontlaser_angular_offset",
-)
-"""The ``PARAM`` names of the front laser's mount ``(x, y, theta)``: metres, metres, radians."""
-
-RESOLUTION_PARAM = "laser_front_laser_resolution"
-"""The ``PARAM`` of the front laser's angle between beams, degrees."""
-
-FOV_PARAM = "laser_front_laser_fov"
-"""The ``PARAM`` of the front laser's field of view, degrees."""
-
-_UNITS = dict.fromkeys(MOUNT_PARAMS[:2], "metres") | {
-    MOUNT_PARAMS[2]: "radians",
-    RESOLUTION_PARAM: "degrees",
-    FOV_PARAM: "degrees",
-}
-
-
-_GUESSED_INCREMENT = {180: 1.0, 181: 1.0, 360: 0.5, 361: 0.5, 400: 0.25, 401: 0.25}
-"""CARMEN's ``carmen_laser_guess_angle_increment``: degrees between beams by beam count."""
-
-
-def flaser_angles(
-    n: int, resolution: float | None = None, fov: float | None = None
-) -> NDArray[np.float64]:
-    """Bearings of an old-format ``FLASER`` scan of ``n`` beams, by CARMEN's own rule.
-
-    The message carries no angles. CARMEN's log reader (``carmen_string_to_robot_laser_
-    message_orig``: ``start_angle = -M_PI / 2`` and ``carmen_laser_guess_angle_increment``)
-    assumes a scan starting at -90° (the right) in steps of 1° for 180 or 181 beams, 0.5° for
-    360 or 361 and 0.25° for 400 or 401; any other count spreads over 180°, both ends
-    included. So 181 beams span -90°..+90°, but 180 beams -90°..+89° (the last beam of a
-    180° scan is not sent), not 180° in steps of 180°/179.
-
-    The same rule reads bags converted from such logs (:func:`fhslam.io.read_bag`), whose
-    converter wrote ``angle_increment = π/(n−1)`` without knowing better.
-
-    Where the log states the laser's ``resolution`` and/or ``fov`` (``PARAM
-    laser_front_laser_resolution`` / ``laser_front_laser_fov``, degrees), the scan is laid
-    out as CARMEN's laser driver does (``laser_main.c``, ``set_laser_config_structure``):
-    ``resolution`` apart, starting at ``-fov / 2``. An unstated ``fov`` is ``n × resolution``
-    when that is one of the SICK's fields of view, 100° or 180° (the driver drops the last
-    beam of such a scan: 180 beams at 1° start at -90°), else ``(n − 1) × resolution``
-    (centred). An unstated ``resolution`` is the guess above where it fits ``fov`` (``n`` is
-    ``fov / step`` or one more), else ``fov / (n − 1)``. Without either, the reader's rule.
-
-    Raises
-    ------
-    ValueError
-        For a non-positive ``resolution`` or ``fov``, or a layout spanning more than 360°.
-    """
-    if resolution is None and fov is None:
-        step = _GUESSED_INCREMENT.get(n)
-        span = np.pi if step is None else np.radians(step) * (n - 1)
-        if n in (181, 361):
-            span = np.pi  # exactly: the last bearing is +90°
-        return np.linspace(-np.pi / 2, -np.pi / 2 + span, n)
-    for name, value in (("resolution", resolution), ("fov", fov)):
-        if value is not None and not (math.isfinite(value) and value > 0):
-            raise ValueError(f"flaser_angles: {name} must be a positive number, got {value}")
-    if resolution is None:
-        guess = _GUESSED_INCREMENT.get(n)
-        fits = guess is not None and any(math.isclose(fov / guess, k) for k in (n, n - 1))
-        resolution = guess if fits else fov / max(n - 1, 1)
-    if fov is None:
-        whole = n * resolution
-        fov = whole if any(math.isclose(whole, f) for f in (100.0, 180.0)) else (n - 1) * resolution
-    if (n - 1) * resolution > 360.0 + 1e-9:
-        raise ValueError(
-            f"flaser_angles: {n} beams {resolution:g}° apart span {(n - 1) * resolution:g}°, "
-            "more than a full turn"
-        )
-    return np.radians(-fov / 2) + np.radians(resolution) * np.arange(n)
-
-
-# ----------------------------------------------------------------------------------- writing
-
-
-def _fmt(values: NDArray | list[float]) -> str:
-    """Space-separated shortest round-trip reprs of floats."""
-    return " ".join(repr(float(v)) for v in np.asarray(values, dtype=float).ravel())
-
-
-def write_carmen(log: Log, path: str | PathLike[str]) -> None:
-    """Write ``log`` as a CARMEN text log: a ``#`` header, three ``PARAM`` lines stating the
-    laser's mount, then ``ODOM`` + laser line per scan.
-
-    Scans whose bearings follow :func:`flaser_angles` are written as old-format ``FLASER``;
-    any other evenly spaced bearings as ``ROBOTLASER1`` (which records start angle and
-    resolution). The poses written are ``log.odometry`` (``ODOM`` and the laser lines'
-    odometry/robot triple) and, as CARMEN's robot module writes it, the laser pose
-    ``log.odometry ⊕ log.laser_offset``; the mount itself goes into ``PARAM
-    robot_frontlaser_offset``, ``robot_frontlaser_side_offset`` and
-    ``robot_frontlaser_angular_offset``, so :func:`read_carmen` gets ``laser_offset`` back
-    exactly. ``log.truth`` is not written (use :func:`fhslam.io.write_trajectory` for it).
-    ``tv``/``rv`` in ``ODOM`` are finite differences of the odometry; ``accel`` is 0.
-
-    Parameters
-    ----------
-    log : Log
-    path : str or path-like
-        Output file, overwritten.
-
-    Raises
-    ------
-    ValueError
-        If the bearings are not evenly spaced (no CARMEN message can describe them).
-    """
-    if log.angle_offsets is not None and np.any(log.angle_offsets != 0):
-        raise ValueError(
-            f"write_carmen: log {log.name!r} has per-scan bearing offsets (an interlaced "
-            "laser), which CARMEN lines cannot describe"
-        )
-    n = log.n_beams
-    angles = log.angles
-    use_flaser = n >= 2 and np.allclose(angles, flaser_angles(n), rtol=0, atol=1e-12)
-    if not use_flaser:
-        res = (angles[-1] - angles[0]) / (n - 1) if n > 1 else 0.0
-        if not np.allclose(angles, angles[0] + np.arange(n) * res, rtol=0, atol=1e-9):
-            raise ValueError(
-                f"write_carmen: log {log.name!r} has unevenly spaced beam angles, which "
-                "neither FLASER nor ROBOTLASER1 can describe"
-            )
-
-    odom = log.odometry
-    dt = np.diff(log.timestamps)
-    step = relative(odom[:-1], odom[1:])
-    ok = dt > 0
-    tv = np.zeros(len(log))
-    rv = np.zeros(len(log))
-    tv[1:][ok] = np.sign(step[ok, 0]) * np.hypot(step[ok, 0], step[ok, 1]) / dt[ok]
-    rv[1:][ok] = wrap_angle(step[ok, 2]) / dt[ok]
-
-    laser = "FLASER" if use_flaser else "ROBOTLASER1"
-    mount = np.asarray(log.laser_offset, dtype=float)
-    mounted = bool(np.any(mount != 0))
-    laser_poses = compose(odom, mount) if mounted else odom
-    header = [
-        f"# CARMEN log written by fhslam: {log.name}, {len(log)} scans of {n} beams, "
-        f"max range {log.max_range!r} m",
-        "# PARAM param_name param_value ipc_timestamp ipc_hostname logger_timestamp",
-        "# ODOM x y theta tv rv accel ipc_timestamp ipc_hostname logger_timestamp",
-        "# FLASER num_readings [range_readings] x y theta odom_x odom_y odom_theta "
-        "ipc_timestamp ipc_hostname logger_timestamp",
-        f"# {laser} poses: the laser's (odometry + mount), then the odometry; "
-        "no ground truth is stored in this file",
-    ]
-    t0 = repr(float(log.timestamps[0])) if len(log) else "0.0"
-    params = [
-        f"PARAM {name} {value!r} {t0} {HOSTNAME} {t0}"
-        for name, value in zip(MOUNT_PARAMS, map(float, mount), strict=True)
-    ]
-    with atomic_output(path) as f:
-        f.write("\n".join(header + params) + "\n")
-        for k in range(len(log)):
-            ts = repr(float(log.timestamps[k]))
-            tail = f"{ts} {HOSTNAME} {ts}"
-            pose = _fmt(odom[k])
-            poses = f"{_fmt(laser_poses[k])} {pose}"
-            f.write(f"ODOM {pose} {_fmt([tv[k], rv[k], 0.0])} {tail}\n")
-            ranges = _fmt(log.ranges[k])
-            if use_flaser:
-                f.write(f"FLASER {n} {ranges} {poses} {tail}\n")
-            else:
-                fov, res = angles[-1] - angles[0], (angles[-1] - angles[0]) / (n - 1)
-                head = _fmt([angles[0], fov, res, log.max_range, 0.01])
-                f.write(
-                    f"ROBOTLASER1 0 {head} 0 {n} {ranges} 0 {poses} "
-                    f"{_fmt([tv[k], rv[k], 0.0, 0.0, 0.0])} {tail}\n"
-                )
-
-
-# ----------------------------------------------------------------------------------- reading
-
-
-def _floats(tokens: list[str], what: str, where: str) -> NDArray[np.float64]:
-    """Parse tokens as floats; a bad token raises :class:`CarmenFormatError` naming it."""
-    try:
-        return np.array(tokens, dtype=float)
-    except ValueError:
-        for i, tok in enumerate(tokens):
-            try:
-                float(tok)
-            except ValueError:
-                raise CarmenFormatError(
-                    f"{where}: non-numeric {what} {tok!r} (item {i + 1} of {len(tokens)})"
-                ) from None
-        raise  # pragma: no cover (numpy refused a list Python accepts)
-
-
-def _count(token: str, what: str, where: str) -> int:
-    """Parse a non-negative integer count field."""
-    try:
-        value = int(token)
-    except ValueError:
-        raise CarmenFormatError(f"{where}: {what} must be an integer, got {token!r}") from None
-    if value < 0:
-        raise CarmenFormatError(f"{where}: {what} must be >= 0, got {value}")
-    return value
-
-
-def _check_finite(values: NDArray[np.float64], what: str, where: str) -> None:
-    if not np.all(np.isfinite(values)):
-        raise CarmenFormatError(f"{where}: non-finite {what} {values.tolist()}")
-
-
-_Parsed = tuple[float, NDArray, NDArray, NDArray, NDArray | None]
-"""What a laser-line parser returns: ``(ipc_timestamp, ranges, odometry, laser_pose,
-geometry)``; ``geometry`` is ``[start_angle, resolution, max_range]`` or ``None``."""
-
-
-def _parse_flaser(fields: list[str], where: str) -> _Parsed:
-    """``FLASER n r_1..r_n x y theta odom_x odom_y odom_theta ipc_ts host logger_ts``."""
-    if len(fields) < 2:
-        raise CarmenFormatError(f"{where}: truncated FLASER line (no num_readings)")
-    n = _count(fields[1], "FLASER num_readings", where)
-    expected = n + 11
-    if len(fields) != expected:
-        # A complete line ends with "... ipc_timestamp hostname logger_timestamp".
-        complete = len(fields) >= 11 and not is_number(fields[-2])
-        if complete:
-            raise CarmenFormatError(
-                f"{where}: wrong reading count: FLASER num_readings is {n} but the line "
-                f"holds {len(fields) - 11} readings"
-            )
-        raise CarmenFormatError(
-            f"{where}: truncated FLASER line: num_readings {n} needs {expected} fields, "
-            f"found {len(fields)}"
-        )
-    ranges = _floats(fields[2 : 2 + n], "range reading", where)
-    poses = _floats(fields[2 + n : 8 + n], "pose value", where)
-    _check_finite(poses, "pose", where)
-    stamp = _floats([fields[8 + n]], "ipc_timestamp", where)
-    _check_finite(stamp, "ipc_timestamp", where)
-    return float(stamp[0]), ranges, poses[3:6], poses[0:3], None
-
-
-def _parse_robotlaser1(fields: list[str], where: str) -> _Parsed:
-    """``ROBOTLASER1`` (see the module docstring); returns the robot pose as odometry.
-
-    The remission block ``num_remissions [remissions]`` is optional (older CARMEN versions
-    write the message without it).
-    """
-    if len(fields) < 9:
-        raise CarmenFormatError(f"{where}: truncated ROBOTLASER1 line ({len(fields)} fields)")
-    head = _floats(fields[2:7], "ROBOTLASER1 header value", where)
-    _check_finite(head, "ROBOTLASER1 start_angle/fov/resolution/max_range/accuracy", where)
-    start, _fov, res, max_range, _acc = head
-    n = _count(fields[8], "ROBOTLASER1 num_readings", where)
-    if len(fields) == 23 + n:  # no remission block
-        tail = fields[9 + n :]
-    else:
-        if len(fields) < 10 + n:
-            raise CarmenFormatError(
-                f"{where}: truncated ROBOTLASER1 line: num_readings {n} needs at least "
-                f"{23 + n} fields, found {len(fields)}"
-            )
-        m = _count(fields[9 + n], "ROBOTLASER1 num_remissions", where)
-        if len(fields) != 24 + n + m:
-            raise CarmenFormatError(
-                f"{where}: ROBOTLASER1 with {n} readings and {m} remissions needs "
-                f"{24 + n + m} fields, found {len(fields)} (truncated line or wrong count)"
-            )
-        tail = fields[10 + n + m :]
-    _check_robotlaser1_head(start, res, max_range, n, where)
-    ranges = _floats(fields[9 : 9 + n], "range reading", where)
-    poses = _floats(tail[0:6], "pose value", where)
-    _check_finite(poses, "pose", where)
-    stamp = _floats([tail[11]], "ipc_timestamp", where)
-    _check_finite(stamp, "ipc_timestamp", where)
-    return float(stamp[0]), ranges, poses[3:6], poses[0:3], np.array([start, res, max_range])
-
-
-def _check_robotlaser1_head(start: float, res: float, max_range: float, n: int, where: str):
-    """Refuse a ``ROBOTLASER1`` header no laser states (see the module docstring)."""
-    if abs(start) > 2 * math.pi:
-        raise CarmenFormatError(
-            f"{where}: ROBOTLASER1 start_angle {start:g} is more than a full turn: CARMEN "
-            "states it in radians, not degrees"
-        )
-    if res <= 0:
-        raise CarmenFormatError(
-            f"{where}: ROBOTLASER1 angular_resolution {res:g} rad: the angle between beams "
-            "must be positive"
-        )
-    if (n - 1) * res > 2 * math.pi + 1e-9:
-        raise CarmenFormatError(
-            f"{where}: ROBOTLASER1 angular_resolution {res:g} rad spreads its {n} beams over "
-            f"{math.degrees((n - 1) * res):g} degrees, more than a full turn"
-        )
-    problem = stated_range_problem(max_range)
-    if problem is not None:
-        raise CarmenFormatError(f"{where}: ROBOTLASER1 maximum_range {problem}")
-
-
-@dataclass(frozen=True)
-class _Param:
-    value: float
-    lineno: int
-
-
-def _read_param(fields: list[str], where: str, lineno: int, params: dict[str, _Param]) -> None:
-    """Record a ``PARAM name value ...`` line of one of the names this reader uses; ignore
-    every other name (a value may be any string)."""
-    if len(fields) < 2:
-        raise CarmenFormatError(f"{where}: PARAM line without a parameter name")
-    name = fields[1]
-    unit = _UNITS.get(name)
-    if unit is None:
-        return
-    if len(fields) < 3:
-        raise CarmenFormatError(f"{where}: PARAM {name} has no value (a number of {unit})")
-    try:
-        value = float(fields[2])
-    except ValueError:
-        raise CarmenFormatError(
-            f"{where}: PARAM {name} value {fields[2]!r} is not a number (of {unit})"
-        ) from None
-    if not math.isfinite(value):
-        raise CarmenFormatError(f"{where}: PARAM {name} value {fields[2]!r} is not finite")
-    if name in (RESOLUTION_PARAM, FOV_PARAM) and not 0 < value <= 360:
-        raise CarmenFormatError(
-            f"{where}: PARAM {name} {value:g} is not an angle in degrees in (0, 360]"
-        )
-    if name == MOUNT_PARAMS[2] and abs(value) > 2 * math.pi:
-        raise CarmenFormatError(
-            f"{where}: PARAM {name} {value:g} is more than a full turn: CARMEN states it in "
-            "radians, not degrees"
-        )
-    seen = params.get(name)
-    if seen is not None and seen.value != value:
-        raise CarmenFormatError(
-            f"{where}: PARAM {name} {value:g} contradicts line {seen.lineno}, which states "
-            f"{seen.value:g}; a log whose laser changes is not supported"
-        )
-    if seen is None:
-        params[name] = _Param(value, lineno)
 
 
 def _fmt_pose(pose: NDArray) -> str:
@@ -557,118 +224,77 @@ def _flaser_layout(path, params: dict[str, _Param], n: int, first: int) -> NDArr
     )
 
 
-_PARSERS = {"FLASER": _parse_flaser, "ROBOTLASER1": _parse_robotlaser1}
-
-MAX_LINE = 1 << 20
-"""The longest line read, in characters (1 MiB of text; a laser line of 100,000 beams is
-about 400 kB). A longer stretch without a line break is not a CARMEN line: it is skipped as
-unreadable, read in pieces of this size, so that no more of it is ever held in memory."""
-
-
 @dataclass
-class _Unreadable:
-    """The lines of a file that are not text (see :func:`_text_lines`), for one warning."""
+class _Scans:
+    """The laser lines of a CARMEN log as read (:func:`_read_scans`), with its mount and
+    layout ``PARAM`` lines and the lines that are not text."""
 
-    lines: int = 0
-    nbytes: int = 0
-    first_line: int = 0
-    start: int = 0  # byte offset of the first unreadable line
-    last_line: int = 0
-    end: int = 0  # byte offset just past the last one
-    reasons: set[str] = field(default_factory=set)
-    size: int = 0  # bytes read in all
-    gzip: bool = False  # the file starts with gzip's magic bytes
+    stamps: list[float] = field(default_factory=list)
+    lines: list[int] = field(default_factory=list)  # the line of each scan, for warnings
+    ranges: list[NDArray] = field(default_factory=list)
+    odometry: list[NDArray] = field(default_factory=list)
+    laser_poses: list[NDArray] = field(default_factory=list)
+    params: dict[str, _Param] = field(default_factory=dict)
+    first: tuple[str, int, int, NDArray | None] | None = None  # kind, lineno, n, geometry
+    junk: _Unreadable = field(default_factory=_Unreadable)
 
-    def add(self, lineno: int, start: int, end: int, reason: str) -> None:
-        if self.last_line != lineno:
-            self.lines += 1
-        if not self.first_line:
-            self.first_line, self.start = lineno, start
-        self.last_line, self.end = lineno, end
-        self.nbytes += end - start
-        self.reasons.add(reason)
-
-    def describe(self) -> str:
-        """``"N bytes that are not text (why) from byte X (line A) to ..."``."""
-        why = ", ".join(sorted(self.reasons))
-        end = "the end of the file" if self.end == self.size else f"byte {self.end}"
-        if self.lines == 1:
-            where = f"from byte {self.start} (line {self.first_line}) to {end}"
-        else:
-            where = (
-                f"in {self.lines} lines from byte {self.start} (line {self.first_line}) to "
-                f"{end} (line {self.last_line})"
-            )
-        return f"{self.nbytes} bytes that are not text ({why}) {where}"
-
-
-class _Gunzipped(gzip.GzipFile):
-    """A gzip-compressed file read as its text: damaged or cut compressed data is a
-    :class:`CarmenFormatError` naming the file and how far it was read."""
-
-    def __init__(self, raw: IO[bytes], path: Path) -> None:
-        super().__init__(fileobj=raw, mode="rb")
-        self._path, self._raw = path, raw
-
-    def read(self, size: int = -1) -> bytes:
-        return self._named(super().read, size)
-
-    def read1(self, size: int = -1) -> bytes:
-        return self._named(super().read1, size)
-
-    def _named(self, read, size: int) -> bytes:
-        try:
-            return read(size)
-        except (EOFError, OSError, zlib.error) as e:
+    def add(self, kind: str, lineno: int, where: str, parsed: _Parsed) -> None:
+        """Keep the laser line ``lineno`` (``where``: ``"{path}:{lineno}"``), parsed; one
+        that does not fit the first scan (message, beam count, layout) is refused."""
+        stamp, r, odom, laser_pose, geom = parsed
+        first = self.first
+        if first is None:
+            self.first = (kind, lineno, len(r), geom)
+            if len(r) == 0:
+                raise CarmenFormatError(f"{where}: {kind} scan has no readings")
+        elif kind != first[0]:
             raise CarmenFormatError(
-                f"{self._path}: damaged gzip data at about byte {self._raw.tell()} of the "
-                f"compressed file ({e}); the log cannot be read past it"
-            ) from None
+                f"{where}: {kind} after {first[0]} messages (line {first[1]}); logs "
+                "mixing both laser messages are not supported"
+            )
+        elif len(r) != first[2]:
+            raise CarmenFormatError(
+                f"{where}: {kind} has {len(r)} readings but the first scan (line "
+                f"{first[1]}) has {first[2]}; varying beam counts are not supported"
+            )
+        elif geom is not None and not np.allclose(geom[:2], first[3][:2]):
+            raise CarmenFormatError(
+                f"{where}: ROBOTLASER1 start_angle/angular_resolution {geom[:2]} differ"
+                f" from the first scan's {first[3][:2]} (line {first[1]})"
+            )
+        self.stamps.append(stamp)
+        self.lines.append(lineno)
+        self.ranges.append(r)
+        self.odometry.append(odom)
+        self.laser_poses.append(laser_pose)
 
 
-def _text_lines(path: Path, junk: _Unreadable) -> Iterator[tuple[int, str]]:
-    """The lines of the file ``path`` that are text, as ``(line number, line)``: decoded as
-    UTF-8 (after gzip's decompression where the file starts with its magic bytes; byte
-    offsets are then those of the decompressed text), a byte-order mark at the start
-    skipped, any line break (``\\n``, ``\\r\\n``, ``\\r``) ending a line, as a text file
-    is read. A line holding NUL bytes or bytes that are
-    not UTF-8, or longer than :data:`MAX_LINE`, is not yielded but recorded in ``junk``. The
-    file is read in pieces of at most :data:`MAX_LINE` characters."""
-    with path.open("rb") as raw:
-        junk.gzip = raw.read(2) == b"\x1f\x8b"
-        raw.seek(0)
-        f = _Gunzipped(raw, path) if junk.gzip else raw
-        head = f.read(3)
-        offset = 3 if head == codecs.BOM_UTF8 else 0
-        f.seek(offset)
-        text = io.TextIOWrapper(f, encoding="utf-8", errors="surrogateescape", newline="")
-        with text:
-            readline = text.readline
-            lineno = 0
-            long_line = False  # the last piece was cut at MAX_LINE: this one continues it
-            while piece := readline(MAX_LINE):
-                start = offset
-                if piece.isascii():
-                    offset += len(piece)
-                    reason = "NUL bytes" if "\x00" in piece else None
-                else:
-                    try:
-                        offset += len(piece.encode("utf-8"))
-                        reason = "NUL bytes" if "\x00" in piece else None
-                    except UnicodeEncodeError:  # a byte that is not UTF-8, as a surrogate
-                        offset += len(piece.encode("utf-8", "surrogateescape"))
-                        reason = "bytes that are not UTF-8"
-                if not long_line:
-                    lineno += 1
-                cut = len(piece) == MAX_LINE and piece[-1] not in "\r\n"
-                if long_line or cut:
-                    reason = reason or f"a line of more than {MAX_LINE} characters"
-                long_line = cut
-                if reason is None:
-                    yield lineno, piece
-                else:
-                    junk.add(lineno, start, offset, reason)
-    junk.size = offset
+def _read_scans(path: Path) -> _Scans:
+    """The laser lines and the mount and layout ``PARAM`` lines of the log ``path``, every
+    other line skipped; a log without a laser line is a :class:`CarmenFormatError`."""
+    scans = _Scans()
+    with reading(path):
+        for lineno, line in _text_lines(path, scans.junk):
+            fields = line.split()
+            if not fields or fields[0].startswith("#"):
+                continue
+            if fields[0] == "PARAM":
+                _read_param(fields, f"{path}:{lineno}", lineno, scans.params)
+                continue
+            if fields[0] not in _PARSERS:
+                continue
+            kind, where = fields[0], f"{path}:{lineno}"
+            scans.add(kind, lineno, where, _PARSERS[kind](fields, where))
+    if scans.first is None:
+        junk = scans.junk
+        if junk.lines:
+            gz = "gzip-compressed, and its text " if junk.gzip else ""
+            raise CarmenFormatError(
+                f"{path}: not a CARMEN text log: {gz}{junk.describe()}, and no FLASER or "
+                "ROBOTLASER1 laser messages"
+            )
+        raise CarmenFormatError(f"{path}: no FLASER or ROBOTLASER1 laser messages found")
+    return scans
 
 
 def read_carmen(path: str | PathLike[str], max_range: float | None = None) -> Log:
@@ -731,71 +357,20 @@ def read_carmen(path: str | PathLike[str], max_range: float | None = None) -> Lo
         (:func:`fhslam.io.log.effective_max_range`).
     """
     path = input_path(path, "CARMEN log")
-    stamps: list[float] = []
-    scan_lines: list[int] = []  # the line of each scan, for warnings
-    ranges: list[NDArray] = []
-    odometry: list[NDArray] = []
-    laser_poses: list[NDArray] = []
-    params: dict[str, _Param] = {}
-    first: tuple[str, int, int, NDArray | None] | None = None  # kind, lineno, n, geometry
-    junk = _Unreadable()
-    with reading(path):
-        for lineno, line in _text_lines(path, junk):
-            fields = line.split()
-            if not fields or fields[0].startswith("#"):
-                continue
-            if fields[0] == "PARAM":
-                _read_param(fields, f"{path}:{lineno}", lineno, params)
-                continue
-            if fields[0] not in _PARSERS:
-                continue
-            kind, where = fields[0], f"{path}:{lineno}"
-            stamp, r, odom, laser_pose, geom = _PARSERS[kind](fields, where)
-            if first is None:
-                first = (kind, lineno, len(r), geom)
-                if len(r) == 0:
-                    raise CarmenFormatError(f"{where}: {kind} scan has no readings")
-            elif kind != first[0]:
-                raise CarmenFormatError(
-                    f"{where}: {kind} after {first[0]} messages (line {first[1]}); logs "
-                    "mixing both laser messages are not supported"
-                )
-            elif len(r) != first[2]:
-                raise CarmenFormatError(
-                    f"{where}: {kind} has {len(r)} readings but the first scan (line "
-                    f"{first[1]}) has {first[2]}; varying beam counts are not supported"
-                )
-            elif geom is not None and not np.allclose(geom[:2], first[3][:2]):
-                raise CarmenFormatError(
-                    f"{where}: ROBOTLASER1 start_angle/angular_resolution {geom[:2]} differ"
-                    f" from the first scan's {first[3][:2]} (line {first[1]})"
-                )
-            stamps.append(stamp)
-            scan_lines.append(lineno)
-            ranges.append(r)
-            odometry.append(odom)
-            laser_poses.append(laser_pose)
-    if first is None:
-        if junk.lines:
-            gz = "gzip-compressed, and its text " if junk.gzip else ""
-            raise CarmenFormatError(
-                f"{path}: not a CARMEN text log: {gz}{junk.describe()}, and no FLASER or "
-                "ROBOTLASER1 laser messages"
-            )
-        raise CarmenFormatError(f"{path}: no FLASER or ROBOTLASER1 laser messages found")
+    scans = _read_scans(path)
+    junk = scans.junk
     if junk.lines:
         warnings.warn(
-            f"{path}:{junk.first_line}: skipped {junk.describe()}; read the {len(stamps)} "
-            "laser scans of the other lines",
+            f"{path}:{junk.first_line}: skipped {junk.describe()}; read the "
+            f"{len(scans.stamps)} laser scans of the other lines",
             CarmenWarning,
             stacklevel=2,
         )
-
-    kind, first_line, n, geom = first
-    r = np.vstack(ranges)
+    kind, first_line, n, geom = scans.first
+    r = np.vstack(scans.ranges)
     stated = None if kind == "FLASER" else float(geom[2])
     if kind == "FLASER":
-        angles = _flaser_layout(path, params, n, first_line)
+        angles = _flaser_layout(path, scans.params, n, first_line)
     else:
         angles = geom[0] + np.arange(n) * geom[1]
     if max_range is None:
@@ -803,13 +378,13 @@ def read_carmen(path: str | PathLike[str], max_range: float | None = None) -> Lo
         max_range, _ = effective_max_range(r, stated, default, path, CarmenWarning)
     else:
         max_range = float(max_range)
-    odo = np.vstack(odometry)
-    check_sequence(path, np.array(stamps), odo, scan_lines, CarmenWarning)
-    check_readings(path, r, max_range, scan_lines, CarmenWarning)
-    mount, source = _laser_mount(path, kind, params, odo, np.vstack(laser_poses))
+    odo = np.vstack(scans.odometry)
+    check_sequence(path, np.array(scans.stamps), odo, scans.lines, CarmenWarning)
+    check_readings(path, r, max_range, scans.lines, CarmenWarning)
+    mount, source = _laser_mount(path, kind, scans.params, odo, np.vstack(scans.laser_poses))
     return Log(
         name=path.stem,
-        timestamps=np.array(stamps),
+        timestamps=np.array(scans.stamps),
         ranges=r,
         angles=angles,
         odometry=odo,

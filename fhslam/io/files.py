@@ -37,17 +37,16 @@ Every reader of :mod:`fhslam` opens its file through :func:`input_path` and
   failure or Ctrl-C before then sends it nothing, and a failed write to it leaves none of the
   files; only a rename failing after it (the folder changed since the check) leaves the stream
   written without the files.
+
+Telling a stream from a file, and writing a stream in place, is the job of
+:mod:`fhslam.io.special_outputs`; its public names are importable from here too.
 """
 
 from __future__ import annotations
 
 import codecs
-import errno
 import itertools
 import os
-import re
-import stat
-import sys
 import tempfile
 from collections.abc import Collection, Iterator
 from contextlib import contextmanager, suppress
@@ -58,6 +57,15 @@ from pathlib import Path
 from typing import IO
 
 from fhslam.errors import InputError, MissingInputError
+from fhslam.io.special_outputs import (
+    STDOUT,
+    _is_char_device,
+    _is_stdout,
+    _output_kind,
+    _write_stream,
+    output_name,
+    writes_to_stdout,
+)
 
 __all__ = [
     "STDOUT",
@@ -71,9 +79,6 @@ __all__ = [
     "reading",
     "writes_to_stdout",
 ]
-
-STDOUT = "-"
-"""The output name that means standard output."""
 
 ENCODING_ERRORS = "fhslam.filenames"
 """The codec error handler of every text output (see the module docs)."""
@@ -98,38 +103,6 @@ def _undecoded_bytes(e: UnicodeError) -> tuple[bytes, int]:
 
 
 codecs.register_error(ENCODING_ERRORS, _undecoded_bytes)
-
-
-def _is_stdout(path: object) -> bool:
-    """Whether ``path`` is :data:`STDOUT` (``"-"``, also as a Path)."""
-    return isinstance(path, str | os.PathLike) and os.fspath(path) == STDOUT
-
-
-def output_name(path: str | os.PathLike[str]) -> str:
-    """``path`` as a message names it: ``"standard output"`` for ``-``."""
-    return "standard output" if _is_stdout(path) else str(path)
-
-
-def writes_to_stdout(*paths: str | os.PathLike[str] | None) -> bool:
-    """Whether an output among ``paths`` goes to this process's standard output: ``-``, or a
-    name of the pipe or file that standard output is (``/dev/stdout``). A command prints its
-    messages to stderr then, so that they do not mix with the output (a terminal, where both
-    show, is not counted)."""
-    try:
-        out = os.fstat(sys.stdout.fileno())
-    except (AttributeError, OSError, ValueError):  # no real stdout (captured, closed)
-        out = None
-    for p in paths:
-        if p is None:
-            continue
-        if _is_stdout(p):
-            return True
-        if out is None or stat.S_ISCHR(out.st_mode):
-            continue
-        with suppress(OSError, ValueError):
-            if os.path.samestat(os.stat(p), out):
-                return True
-    return False
 
 
 def input_path(path: str | os.PathLike[str], what: str = "") -> Path:
@@ -173,57 +146,6 @@ def _is_file(p: Path) -> bool:
         return p.is_file()
     except OSError:
         return False
-
-
-_DESCRIPTOR_FOLDER = re.compile(r"/proc/(?:self|thread-self|\d+)(?:/task/\d+)?/fd")
-"""A process's folder of open descriptors, where ``/dev/fd`` and ``/dev/stdout`` lead."""
-
-
-def _names_a_descriptor(p: Path) -> bool:
-    """Whether ``p`` is, or leads through symbolic links to, an open descriptor of a process
-    (``/dev/fd/3``, ``/dev/stdout``, ``/proc/self/fd/1``): a stream, even where it is a
-    regular file, since its folder is no place for a temporary file."""
-    q = os.path.abspath(p)
-    for _ in range(40):  # the kernel's limit on links followed
-        folder = os.path.realpath(os.path.dirname(q))
-        if _DESCRIPTOR_FOLDER.fullmatch(folder):
-            return True
-        try:
-            link = os.readlink(q)
-        except OSError:  # not a link
-            return False
-        q = os.path.abspath(os.path.join(folder, link))
-    return False
-
-
-def _output_kind(p: Path, what: str) -> str:
-    """``"stream"`` if the output ``p`` exists and is not a regular file or names a
-    descriptor (written in place), ``"file"`` if it is a regular file or does not exist
-    (written to a temporary file and renamed); ``what`` names it in errors.
-
-    Raises
-    ------
-    InputError
-        If ``p`` is a directory or a socket, or cannot be looked up (a name too long).
-    """
-    try:
-        st = os.stat(p)
-    except (FileNotFoundError, NotADirectoryError):
-        return "file"  # a new file; its folder is checked where it is created
-    except OSError as e:
-        if e.errno == errno.ELOOP:  # a loop of links: replaced by the file, as a link is
-            return "file"
-        raise InputError(f"{what}: cannot write ({e.strerror or e})") from None
-    if stat.S_ISDIR(st.st_mode):
-        raise InputError(f"{what}: is a directory; give a file name for the output")
-    if stat.S_ISSOCK(st.st_mode):
-        raise InputError(
-            f"{what}: is a socket, which cannot be opened for writing; give a file, a pipe "
-            "or - (standard output)"
-        )
-    if not stat.S_ISREG(st.st_mode) or _names_a_descriptor(p):
-        return "stream"
-    return "file"
 
 
 def check_folder_writable(folder: str | os.PathLike[str], what: str) -> None:
@@ -305,13 +227,6 @@ def check_outputs(
     for what, path in files.items():
         if _output_kind(path, f"{what} {path}") == "file":
             check_folder_writable(path.parent, f"{what} {path}")
-
-
-def _is_char_device(p: Path) -> bool:
-    try:
-        return stat.S_ISCHR(os.stat(p).st_mode)
-    except OSError:
-        return False
 
 
 @contextmanager
@@ -579,45 +494,3 @@ def _stream_output(target: str | Path, mode: str) -> Iterator[IO]:
         _COMMITTED[0] += 1
     else:
         batch.streams.append((target, data))
-
-
-def _write_stream(target: str | Path, data: bytes) -> None:
-    """Write ``data`` to the stream ``target`` in place (``-``: standard output, not closed).
-
-    Raises
-    ------
-    InputError
-        ``"{target}: cannot write ({reason})"``, e.g. no space left on the device, a broken
-        pipe, or a path that cannot be opened.
-    """
-    if _is_stdout(target):
-        try:
-            sys.stdout.flush()
-            out = getattr(sys.stdout, "buffer", None)
-            if out is None:  # a text-only stand-in (tests): the same text
-                sys.stdout.write(data.decode("utf-8", "surrogateescape"))
-            else:
-                out.write(data)
-            sys.stdout.flush()
-        except OSError as e:
-            _abandon_stdout()
-            raise InputError(f"standard output: cannot write ({e.strerror or e})") from None
-        return
-    try:
-        with open(target, "wb") as f:
-            f.write(data)
-    except OSError as e:
-        raise InputError(f"{target}: cannot write ({e.strerror or e})") from None
-
-
-def _abandon_stdout() -> None:
-    """Point standard output at the null device after a write to it failed (a closed pipe, a
-    full disk), so that Python's flush at exit does not fail again with a traceback-like
-    "Exception ignored" message."""
-    with suppress(AttributeError, OSError, ValueError):
-        fd = sys.stdout.fileno()
-        null = os.open(os.devnull, os.O_WRONLY)
-        try:
-            os.dup2(null, fd)
-        finally:
-            os.close(null)

@@ -49,6 +49,7 @@ import heapq
 import itertools
 import warnings
 from collections.abc import Iterator
+from dataclasses import dataclass
 from os import PathLike
 from pathlib import Path
 from typing import Any
@@ -207,7 +208,6 @@ def read_bag(
     from rosbags.highlevel import AnyReader
     from rosbags.typesys import Stores, get_typestore
 
-    max_range_override = max_range
     if beams not in ("carmen", "bag"):
         raise ValueError(f"beams must be 'carmen' or 'bag', got {beams!r}")
     p = Path(path)
@@ -223,58 +223,24 @@ def read_bag(
     try:
         scan_conns = _pick(reader, SCAN_TYPE, scan_topic, "laser scan", p)
         odom_conns = _pick(reader, ODOM_TYPE, odom_topic, "odometry", p)
-        stamps, ranges, layout, max_range, starts = [], [], set(), 0.0, []
-        widest = (0, 0)  # beams, scan index
-        for k, conn, m in _messages(reader, scan_conns, "scan", p):
-            problem = _scan_problem(m)
-            if problem is not None:
-                raise BagFormatError(f"{p}: scan {k} of topic {conn.topic!r}: {problem}")
-            widest = max(widest, (len(m.ranges), -k))
-            stamps.append(m.header.stamp.sec + 1e-9 * m.header.stamp.nanosec)
-            ranges.append(np.asarray(m.ranges, dtype=float))
-            layout.add((round(float(m.angle_min), 6), round(float(m.angle_increment), 7)))
-            starts.append(float(m.angle_min))
-            max_range = max(max_range, float(m.range_max))
-        if not stamps:
-            raise BagFormatError(f"{p}: topic {scan_conns[0].topic!r} holds no scans")
-        if widest[0] < 2:
-            raise BagFormatError(
-                f"{p}: scan {-widest[1]} of topic {scan_conns[0].topic!r}: the widest scan "
-                f"has {plural(widest[0], 'beam')}; a laser scan has at least 2"
-            )
-        a0, inc = min(layout)
-        interlaced = all(i == inc and 0 <= a - a0 < inc for a, i in layout)
-        if len(layout) > 1 and not interlaced:
-            raise BagFormatError(f"{p}: scans with different angle layouts {sorted(layout)}")
-        odo_t, odo = [], []
-        for k, conn, m in _messages(reader, odom_conns, "odometry message", p):
-            odo_t.append(m.header.stamp.sec + 1e-9 * m.header.stamp.nanosec)
-            pose = m.pose.pose
-            problem = _pose_problem(pose.position, pose.orientation)
-            if problem is not None:
-                raise BagFormatError(
-                    f"{p}: odometry message {k} of topic {conn.topic!r}: {problem}"
-                )
-            odo.append((pose.position.x, pose.position.y, _yaw(pose.orientation)))
-        if not odo_t:
-            raise BagFormatError(f"{p}: topic {odom_conns[0].topic!r} holds no odometry")
+        scans = _read_scans(reader, scan_conns, p)
+        odo_t, odo = _read_odometry(reader, odom_conns, p)
         offset = _laser_offset(reader, p)
     finally:
         reader.close()
 
-    n = max(len(r) for r in ranges)
-    rr = np.full((len(ranges), n), np.nan)
-    for k, r in enumerate(ranges):
-        rr[k, : len(r)] = r  # shorter scans of the same layout: missing beams are invalid
+    rr = scans.ranges_array()
+    n = rr.shape[1]
+    a0, inc = scans.a0, scans.inc
     converted = abs(inc - np.pi / (n - 1)) < 1e-6
     angles = flaser_angles(n) if beams == "carmen" and converted else a0 + inc * np.arange(n)
-    stated = max_range
-    if max_range_override is None:
-        in_time = rr[np.argsort(stamps, kind="stable")]  # repeated scans are found in order
+    stated = scans.range_max
+    if max_range is None:
+        in_time = rr[np.argsort(scans.stamps, kind="stable")]  # repeated scans are found in order
         max_range, _ = effective_max_range(in_time, stated, stated, p, BagWarning)
     else:
-        max_range = float(max_range_override)
-    t = np.asarray(stamps)
+        max_range = float(max_range)
+    t = np.asarray(scans.stamps)
     order = np.argsort(t, kind="stable")
     odometry = _interpolate_poses(np.asarray(odo_t), np.asarray(odo), t[order], p)  # may refuse
     back = np.diff(t) < 0
@@ -297,10 +263,87 @@ def read_bag(
         odometry=odometry,
         max_range=max_range,
         laser_offset=offset,
-        angle_offsets=(np.asarray(starts)[order] - a0) if len(layout) > 1 else None,
+        angle_offsets=scans.angle_offsets(order),
         laser_offset_source="tf_static",
         stated_max_range=stated,
     )
+
+
+def _stamp(m) -> float:
+    """A message's header stamp, seconds."""
+    return m.header.stamp.sec + 1e-9 * m.header.stamp.nanosec
+
+
+@dataclass
+class _Scans:
+    """The scans of a bag's laser topic in the bag's order (:func:`_read_scans`)."""
+
+    stamps: list[float]  # header stamps
+    ranges: list[NDArray[np.float64]]
+    starts: list[float]  # angle_min of each scan
+    layouts: set[tuple[float, float]]  # the (angle_min, angle_increment) met, rounded
+    range_max: float  # the largest range_max stated
+    a0: float  # angle_min of the first layout (the smallest)
+    inc: float  # its angle_increment, which every layout shares
+
+    def ranges_array(self) -> NDArray[np.float64]:
+        """The readings as one array (T, B), B the widest scan's beams."""
+        n = max(len(r) for r in self.ranges)
+        rr = np.full((len(self.ranges), n), np.nan)
+        for k, r in enumerate(self.ranges):
+            rr[k, : len(r)] = r  # shorter scans of the same layout: missing beams are invalid
+        return rr
+
+    def angle_offsets(self, order: NDArray[np.intp]) -> NDArray[np.float64] | None:
+        """Each scan's start beyond the first layout's, in ``order`` (an interlaced laser),
+        or ``None`` where all scans share one layout."""
+        return (np.asarray(self.starts)[order] - self.a0) if len(self.layouts) > 1 else None
+
+
+def _read_scans(reader, conns, path: Path) -> _Scans:
+    """The scans of the laser topic ``conns``; a scan stating what no laser has (module
+    docs), no scans, no scan of two beams or more, and layouts that differ other than as an
+    interlaced laser's are a :class:`BagFormatError`."""
+    stamps, ranges, layouts, range_max, starts = [], [], set(), 0.0, []
+    widest = (0, 0)  # beams, scan index
+    for k, conn, m in _messages(reader, conns, "scan", path):
+        problem = _scan_problem(m)
+        if problem is not None:
+            raise BagFormatError(f"{path}: scan {k} of topic {conn.topic!r}: {problem}")
+        widest = max(widest, (len(m.ranges), -k))
+        stamps.append(_stamp(m))
+        ranges.append(np.asarray(m.ranges, dtype=float))
+        layouts.add((round(float(m.angle_min), 6), round(float(m.angle_increment), 7)))
+        starts.append(float(m.angle_min))
+        range_max = max(range_max, float(m.range_max))
+    if not stamps:
+        raise BagFormatError(f"{path}: topic {conns[0].topic!r} holds no scans")
+    if widest[0] < 2:
+        raise BagFormatError(
+            f"{path}: scan {-widest[1]} of topic {conns[0].topic!r}: the widest scan "
+            f"has {plural(widest[0], 'beam')}; a laser scan has at least 2"
+        )
+    a0, inc = min(layouts)
+    interlaced = all(i == inc and 0 <= a - a0 < inc for a, i in layouts)
+    if len(layouts) > 1 and not interlaced:
+        raise BagFormatError(f"{path}: scans with different angle layouts {sorted(layouts)}")
+    return _Scans(stamps, ranges, starts, layouts, range_max, a0, inc)
+
+
+def _read_odometry(reader, conns, path: Path) -> tuple[list[float], list[tuple]]:
+    """The stamps and poses ``(x, y, yaw)`` of the odometry topic ``conns``; no odometry, or
+    a pose no robot can have, is a :class:`BagFormatError`."""
+    odo_t, odo = [], []
+    for k, conn, m in _messages(reader, conns, "odometry message", path):
+        odo_t.append(_stamp(m))
+        pose = m.pose.pose
+        problem = _pose_problem(pose.position, pose.orientation)
+        if problem is not None:
+            raise BagFormatError(f"{path}: odometry message {k} of topic {conn.topic!r}: {problem}")
+        odo.append((pose.position.x, pose.position.y, _yaw(pose.orientation)))
+    if not odo_t:
+        raise BagFormatError(f"{path}: topic {conns[0].topic!r} holds no odometry")
+    return odo_t, odo
 
 
 def _laser_offset(reader, path: Path) -> NDArray[np.float64]:

@@ -16,7 +16,8 @@ from numpy.typing import ArrayLike, NDArray
 from fhslam.errors import InputError, InputWarning
 from fhslam.geometry import wrap_angle
 from fhslam.io.files import atomic_output
-from fhslam.io.log import check_sequence, read_numeric_table
+from fhslam.io.log import read_numeric_table
+from fhslam.io.plausibility import check_sequence
 
 
 class TrajectoryFormatError(InputError):

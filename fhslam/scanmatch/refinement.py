@@ -1,0 +1,239 @@
+"""Point-to-line refinement: the pose of a query cloud against a
+:class:`fhslam.scanmatch.grids.PointMap`, by Gauss-Newton rounds of nearest-neighbour pairs
+(compiled, rounded as the NumPy and LAPACK code they replace, bit for bit).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from llvmlite import ir
+from numpy.typing import ArrayLike, NDArray
+
+from fhslam._numba import intrinsic, njit, types
+from fhslam.geometry import as_points, as_pose
+from fhslam.scanmatch.grids import PointMap
+
+__all__ = ["Refinement", "refine"]
+
+
+@njit(cache=True, nogil=True)
+def _accumulate(
+    q0, x, y, th, pts, nrm, lo, cell, nx, ny, starts, order, max_d, huber
+):  # pragma: no cover
+    """One Gauss-Newton round of :func:`refine`: each query point at the pose ``(x, y, th)``
+    paired with its nearest map point closer than ``max_d``; returns the weighted normal
+    equations ``(H, g)``, the number of pairs and the sum of squared residuals."""
+    h = np.zeros((3, 3))
+    g = np.zeros(3)
+    c, s = np.cos(th), np.sin(th)
+    reach = int(np.ceil(max_d / cell))
+    n_ok, ss = 0, 0.0
+    jac = np.empty(3)
+    for k in range(q0.shape[0]):
+        qx = c * q0[k, 0] - s * q0[k, 1] + x
+        qy = s * q0[k, 0] + c * q0[k, 1] + y
+        ix = int(np.floor((qx - lo[0]) / cell))
+        iy = int(np.floor((qy - lo[1]) / cell))
+        best, bj = max_d * max_d, -1
+        # cells in rings around the point's own; a cell (or a ring) whose nearest edge is
+        # farther than the best pair so far cannot hold a nearer point (the margin covers
+        # rounding in the cell index)
+        ax, ay = qx - lo[0] - ix * cell, qy - lo[1] - iy * cell
+        for r in range(reach + 1):
+            if r >= 2 and ((r - 1) * cell) ** 2 > best * (1 + 1e-9) + 1e-18:
+                break
+            for u in range(ix - r, ix + r + 1):
+                if u < 0 or u >= nx:
+                    continue
+                gx = (
+                    0.0
+                    if u == ix
+                    else ((u - ix) * cell - ax if u > ix else ax + (ix - u - 1) * cell)
+                )
+                step = 1 if abs(u - ix) == r else 2 * r
+                for v in range(iy - r, iy + r + 1, max(step, 1)):
+                    if v < 0 or v >= ny:
+                        continue
+                    gy = (
+                        0.0
+                        if v == iy
+                        else ((v - iy) * cell - ay if v > iy else ay + (iy - v - 1) * cell)
+                    )
+                    if gx * gx + gy * gy > best * (1 + 1e-9) + 1e-18:
+                        continue
+                    cc = u * ny + v
+                    for t in range(starts[cc], starts[cc + 1]):
+                        j = order[t]
+                        dx, dy = qx - pts[j, 0], qy - pts[j, 1]
+                        d2 = dx * dx + dy * dy
+                        if d2 < best or (d2 == best and bj >= 0 and j < bj):
+                            best, bj = d2, j
+        if bj < 0:
+            continue
+        nx_, ny_ = nrm[bj, 0], nrm[bj, 1]
+        r = nx_ * (qx - pts[bj, 0]) + ny_ * (qy - pts[bj, 1])
+        jac[0], jac[1] = nx_, ny_
+        jac[2] = ny_ * (qx - x) - nx_ * (qy - y)
+        # Huber on the residual, tapered to 0 at max_d: a pair forming or breaking at the
+        # cut-off changes nothing abruptly
+        w = min(1.0, huber / max(abs(r), 1e-12)) * (1.0 - best / (max_d * max_d)) ** 2
+        for a in range(3):
+            g[a] += w * jac[a] * r
+            for b in range(3):
+                h[a, b] += w * jac[a] * jac[b]
+        n_ok += 1
+        ss += r * r
+    return h, g, n_ok, ss
+
+
+@dataclass(frozen=True)
+class Refinement:
+    """Result of :func:`refine`: the pose, the information of the point-to-line residuals
+    about it (3 x 3, per squared metre of residual; units 1/m², 1/(m·rad), 1/rad²), the
+    number of query points that found a line and their rms distance to it (metres)."""
+
+    pose: NDArray[np.float64]
+    hessian: NDArray[np.float64]
+    n_matched: int
+    rms: float
+
+
+def refine(
+    target: PointMap,
+    query: ArrayLike,
+    guess: ArrayLike,
+    max_distance: float = 0.1,
+    iterations: int = 10,
+    huber: float = 0.02,
+    min_eigen_ratio: float = 1e-3,
+    prior: tuple[ArrayLike, ArrayLike] | None = None,
+) -> Refinement:
+    """Point-to-line ICP: the pose of ``query`` in ``target``'s frame near ``guess``.
+
+    Each query point is paired with its nearest target point within ``max_distance``; the
+    pose minimises the weighted squared distances of the query points to those points'
+    tangent lines (Gauss-Newton, a fixed number of rounds: Huber weights, tapered to zero at
+    ``max_distance``). Along a direction the pairs do
+    not constrain (a corridor's axis: eigenvalue under ``min_eigen_ratio`` of the largest)
+    the guess is kept; :attr:`Refinement.hessian` tells the caller how little is known
+    there.
+
+    ``prior=(pose, information)`` adds ``(x - pose)ᵀ information (x - pose)`` to the cost
+    (information in the residuals' units, 1/m² per squared metre of residual): where the
+    pairs say nothing, ``pose`` (e.g. the odometry's prediction) is kept instead of the
+    guess. :attr:`Refinement.hessian` holds the pairs' information only.
+    """
+    q0 = as_points(query, "query")
+    x = as_pose(guess, "guess").copy()
+    if prior is not None:
+        prior_pose = as_pose(prior[0], "prior pose")
+        prior_info = np.asarray(prior[1], dtype=float).reshape(3, 3)
+    if not max_distance > 0:
+        raise ValueError(f"max_distance must be > 0, got {max_distance}")
+    if len(target.points) == 0 or iterations < 1:
+        return Refinement(x, np.zeros((3, 3)), 0, 0.0)
+    nx, ny = target.shape
+    if prior is None:
+        prior_pose, prior_info = np.zeros(3), np.zeros((3, 3))
+    x, h, n_ok, rms = _gauss_newton(
+        np.ascontiguousarray(q0), x, target.points, target.normals, target.origin,
+        target.cell, nx, ny, target.starts, target.order, float(max_distance), float(huber),
+        int(iterations), float(min_eigen_ratio), prior is not None,
+        np.ascontiguousarray(prior_pose), np.ascontiguousarray(prior_info),
+    )  # fmt: skip
+    return Refinement(x, h, int(n_ok), float(rms))
+
+
+@intrinsic
+def _fma(typingctx, a, b, c):  # pragma: no cover (compiled)
+    """``a * b + c`` rounded once (LLVM's ``llvm.fma``: one instruction where the CPU has
+    it, else a correctly rounded library call)."""
+    sig = types.float64(types.float64, types.float64, types.float64)
+
+    def codegen(context, builder, signature, args):
+        d = ir.DoubleType()
+        fn = builder.module.declare_intrinsic("llvm.fma", [d], ir.FunctionType(d, [d, d, d]))
+        return builder.call(fn, args)
+
+    return sig, codegen
+
+
+@njit(cache=True, nogil=True)
+def _dot_rows(a, x):  # pragma: no cover
+    """``a @ x`` rounded as NumPy's ``@`` is for a C-ordered ``a``: OpenBLAS's transposed
+    matrix-vector kernel (x86-64) forms each row's dot product as the second product, then
+    fused multiply-adds of the first, the third, ..."""
+    out = np.empty(a.shape[0])
+    for i in range(a.shape[0]):
+        if a.shape[1] == 1:
+            out[i] = a[i, 0] * x[0]
+            continue
+        s = _fma(a[i, 0], x[0], a[i, 1] * x[1])
+        for j in range(2, a.shape[1]):
+            s = _fma(a[i, j], x[j], s)
+        out[i] = s
+    return out
+
+
+@njit(cache=True, nogil=True)
+def _dot_columns(a, x):  # pragma: no cover
+    """``a @ x`` rounded as NumPy's ``@`` is for a Fortran-ordered ``a`` (what a boolean
+    selection of columns gives): OpenBLAS's kernel adds column after column, each by a fused
+    multiply-add."""
+    out = np.empty(a.shape[0])
+    for i in range(a.shape[0]):
+        s = a[i, 0] * x[0]
+        for j in range(1, a.shape[1]):
+            s = _fma(a[i, j], x[j], s)
+        out[i] = s
+    return out
+
+
+@njit(cache=True, nogil=True)
+def _gauss_newton(
+    q0,
+    x,
+    pts,
+    nrm,
+    lo,
+    cell,
+    nx,
+    ny,
+    starts,
+    order,
+    max_d,
+    huber,
+    iterations,
+    min_eigen_ratio,
+    use_prior,
+    prior_pose,
+    prior_info,
+):  # pragma: no cover
+    """The rounds of :func:`refine`, compiled: each pairs the points (:func:`_accumulate`)
+    and takes a Gauss-Newton step, rounded as the NumPy code it replaces, bit for bit
+    (LAPACK's solve and symmetric eigensolver; the products as :func:`_dot_rows` and
+    :func:`_dot_columns`). Returns
+    ``(pose, H, pairs, rms)``."""
+    h, n_ok, rms = np.zeros((3, 3)), 0, 0.0
+    for it in range(iterations):
+        h, g, n_ok, ss = _accumulate(
+            q0, x[0], x[1], x[2], pts, nrm, lo, cell, nx, ny, starts, order, max_d, huber
+        )
+        if n_ok < 10:
+            return x, np.zeros((3, 3)), n_ok, 0.0
+        rms = np.sqrt(ss / n_ok)
+        if it == iterations - 1:
+            break
+        if use_prior:
+            dp = x - prior_pose
+            dp[2] = np.arctan2(np.sin(dp[2]), np.cos(dp[2]))
+            delta = -np.linalg.solve(h + prior_info, g + _dot_rows(prior_info, dp))
+        else:
+            evals, evecs = np.linalg.eigh(h)
+            keep = evals > min_eigen_ratio * max(evals[-1], 1e-12)
+            v = evecs[:, keep]  # NumPy's is Fortran-ordered, its transpose C-ordered
+            delta = -_dot_columns(v, _dot_rows(np.ascontiguousarray(v.T), g) / evals[keep])
+        x = x + delta  # no early stop: runs that differ in the last bit stay that close
+    return x, h, n_ok, rms

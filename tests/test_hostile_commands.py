@@ -206,7 +206,7 @@ def test_an_output_folder_it_created_is_removed_if_the_work_fails(tmp_path):
 def test_slam_refuses_an_unwritable_map_folder_before_reading_the_log(
     paper_clf, tmp_path, unwritable, monkeypatch, capsys
 ):
-    import fhslam.cli
+    import fhslam.cli.slam
 
     out = tmp_path / "out.txt"
     argv = ["slam", str(paper_clf), "--trajectory", str(out), "--map", str(unwritable / "m.json")]
@@ -214,7 +214,7 @@ def test_slam_refuses_an_unwritable_map_folder_before_reading_the_log(
     assert r.returncode == 2 and r.stdout == ""
     one_line_error(r.stderr, f"--map {unwritable / 'm.json'}: cannot write (folder {unwritable}")
     assert files(tmp_path) == ["ro"]
-    monkeypatch.setattr(fhslam.cli, "_load", lambda args: pytest.fail("the log was read"))
+    monkeypatch.setattr(fhslam.cli.slam, "read_log", lambda args: pytest.fail("the log was read"))
     assert main(argv) == 2
     one_line_error(capsys.readouterr().err, "cannot write")
 

@@ -50,7 +50,7 @@
 # `run_slam(log)` and `fhslam slam LOG` run), keeps the paper's fast Hough lines for the map but
 # places the robot with a pose graph:
 #
-# - **Scan-to-map tracking** (`fhslam.slam.tracker`): every scan is placed against the points of
+# - **Scan-to-map tracking** (`fhslam.slam.graph.tracker`): every scan is placed against the points of
 #   the last few keyframes by an exhaustive correlative search around the odometry prediction,
 #   then refined point to line. Real odometry glitches (a heading jump of tens of degrees between
 #   two scans happens on both logs here), so when the match is poor or the odometry step

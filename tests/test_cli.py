@@ -12,6 +12,7 @@ import pytest
 from fhslam.cli import main
 from fhslam.io import read_carmen, read_trajectory
 from fhslam.sim import paper_world, simulate
+from fhslam.slam.graph import KeyframeParams, LoopParams, TrackerParams
 
 
 def run(*args: str) -> subprocess.CompletedProcess:
@@ -655,12 +656,12 @@ def test_a_bug_is_not_reported_as_bad_input(monkeypatch, capsys):
     """Only an InputError is bad input (exit status 2): any other exception is a bug in the
     package, one line ``fhslam: internal error: ...`` and exit status 1, and ``--debug``
     shows its traceback instead."""
-    import fhslam.cli
+    import fhslam.cli.simulate
 
     def broken(args):
         raise ValueError("an internal inconsistency")
 
-    monkeypatch.setattr(fhslam.cli, "_simulate", broken)
+    monkeypatch.setattr(fhslam.cli.simulate, "run", broken)
     assert main(["simulate", "paper", "--log", "x.clf", "--truth", "t.txt"]) == 1
     err = capsys.readouterr().err
     assert err.startswith("fhslam: internal error: ValueError: an internal inconsistency (")
@@ -914,17 +915,20 @@ def test_slam_set_runs_the_graph_method_with_those_parameters(short_clf, tmp_pat
     from fhslam.slam import GraphSlamParams
 
     out = tmp_path / "t.txt"
-    sets = ["--set", "smooth_clouds=false", "--set", "loop_target_keyframes = 3"]
+    sets = ["--set", "keyframes.voxel=0.05", "--set", "loops.target_keyframes = 3"]
     assert main(["slam", str(short_clf), "--trajectory", str(out), "--quiet", *sets]) == 0
     header = out.read_text().splitlines()[0]
-    assert "--set smooth_clouds=false --set loop_target_keyframes = 3" in header
+    assert "--set keyframes.voxel=0.05 --set loops.target_keyframes = 3" in header
     log = read_carmen(short_clf)
-    expected = run_slam(log, params=GraphSlamParams(smooth_clouds=False, loop_target_keyframes=3))
+    params = GraphSlamParams(
+        keyframes=KeyframeParams(voxel=0.05), loops=LoopParams(target_keyframes=3)
+    )
+    expected = run_slam(log, params=params)
     t, poses = read_trajectory(out)
     np.testing.assert_array_equal(t, expected.timestamps)
     np.testing.assert_allclose(poses, expected.poses, atol=1e-9)  # the file's 9+ digits
     default = run_slam(log).poses
-    assert np.abs(default - expected.poses).max() > 1e-6  # no smoothing changed the run
+    assert np.abs(default - expected.poses).max() > 1e-6  # coarser clouds changed the run
 
 
 def test_slam_set_reaches_the_trackers_parameters(short_clf, tmp_path):
@@ -932,15 +936,15 @@ def test_slam_set_reaches_the_trackers_parameters(short_clf, tmp_path):
     (``GraphSlamParams.tracker``), beside the graph's own."""
     from fhslam.pipeline import run_slam
     from fhslam.slam import GraphSlamParams
-    from fhslam.slam.tracker import TrackerParams
 
     out = tmp_path / "t.txt"
-    sets = ["--set", "tracker.window=0.3", "--set", "tracker.angle_step_deg=1", "--set",
-            "loop_target_keyframes=4"]  # fmt: skip
+    sets = ["--set", "tracker.window=0.3", "--set", "tracker.resolution=0.1", "--set",
+            "loops.target_keyframes=4"]  # fmt: skip
     assert main(["slam", str(short_clf), "--trajectory", str(out), "--quiet", *sets]) == 0
     log = read_carmen(short_clf)
-    tracker = TrackerParams(window=0.3, angle_step_deg=1.0)
-    expected = run_slam(log, params=GraphSlamParams(tracker=tracker, loop_target_keyframes=4))
+    tracker = TrackerParams(window=0.3, resolution=0.1)
+    params = GraphSlamParams(tracker=tracker, loops=LoopParams(target_keyframes=4))
+    expected = run_slam(log, params=params)
     t, poses = read_trajectory(out)
     np.testing.assert_array_equal(t, expected.timestamps)
     np.testing.assert_allclose(poses, expected.poses, atol=1e-9)
@@ -952,21 +956,22 @@ def test_slam_set_reaches_the_trackers_parameters(short_clf, tmp_path):
     [
         (
             "foo=1",
-            "'foo' is not a number or switch of GraphSlamParams (or, as tracker.NAME, of its "
-            "TrackerParams); one of: cloud_max_range",
+            "'foo' is not a number or switch of GraphSlamParams or of its groups (",
         ),
+        ("lines.extraction.foo=1", "'lines.extraction.foo' is not a number or switch"),
         ("tracker=1", "'tracker' is not a number or switch"),
         ("odometry_sigma=0.1", "'odometry_sigma' is not a number or switch"),
-        ("loop_target_keyframes=1.5", "loop_target_keyframes takes an integer, got '1.5'"),
-        ("smooth_clouds=maybe", "smooth_clouds takes true or false, got 'maybe'"),
-        ("loop_min_score=nan", "loop_min_score takes a finite number, got 'nan'"),
-        ("loop_min_score=1.5", "'loop_min_score=1.5': GraphSlamParams.loop_min_score must be in"),
-        ("loop_target_keyframes=-1", "loop_target_keyframes must be >= 0 and at most 1000"),
-        ("loop_target_keyframes", "expected NAME=VALUE"),
+        ("loops.target_keyframes=1.5", "loops.target_keyframes takes an integer, got '1.5'"),
+        ("lines.extraction.drop_lone_points=maybe", "drop_lone_points takes true or false"),
+        ("loops.min_score=nan", "loops.min_score takes a finite number, got 'nan'"),
+        ("loops.min_score=1.5", "'loops.min_score=1.5': LoopParams.min_score must be in"),
+        ("loops.target_keyframes=-1", "target_keyframes must be >= 0 and at most 1000"),
+        ("loops.target_keyframes", "expected NAME=VALUE"),
+        ("loop_target_keyframes=3", "'loop_target_keyframes' is not a number or switch"),
         ("tracker.foo=1", "'tracker.foo' is not a number or switch"),
         ("tracker.prior_sigma=1", "'tracker.prior_sigma' is not a number or switch"),
         ("tracker.refine_iterations=2.5", "tracker.refine_iterations takes an integer"),
-        ("tracker.sigma=0", "--set 'tracker.sigma=0': TrackerParams.sigma must be >= 0.001"),
+        ("tracker.resolution=0", "--set 'tracker.resolution=0': TrackerParams.resolution must"),
         ("=6", "expected NAME=VALUE"),
     ],
 )
@@ -977,9 +982,39 @@ def test_slam_bad_set_is_named_and_writes_nothing(short_clf, tmp_path, setting, 
     assert list(tmp_path.iterdir()) == []
 
 
+def test_set_reaches_every_group_of_the_parameters():
+    """``--set GROUP.NAME=VALUE`` reaches a number or switch of any group of
+    ``GraphSlamParams``, at any depth, by ``dataclasses.replace`` on the defaults; an
+    optional number also takes ``none``; the error names the groups and every settable name,
+    and a value out of range names the ``--set`` that gave it."""
+    from dataclasses import replace
+
+    from fhslam.cli.common import graph_params
+    from fhslam.errors import InputError
+    from fhslam.slam import GraphSlamParams
+
+    params = graph_params(
+        ["lines.extraction.cluster_gap=0.3", "tracker.window = 0.3", "lines.robust_scale=none"]
+    )
+    default = GraphSlamParams()
+    assert params.lines.extraction.cluster_gap == 0.3 and params.tracker.window == 0.3
+    assert params.lines.robust_scale is None
+    assert params.lines.matching == default.lines.matching
+    assert replace(params.tracker, window=default.tracker.window) == default.tracker
+    with pytest.raises(InputError) as e:
+        graph_params(["foo=1"])
+    for part in ("tracker.NAME: TrackerParams", "lines.extraction.NAME: ExtractionParams"):
+        assert part in str(e.value)
+    assert "lines.extraction.cluster_gap, " in str(e.value).partition("; one of: ")[2]
+    with pytest.raises(InputError, match=r"^--set 'lines\.extraction\.densify_step=1e-9': Ext"):
+        graph_params(["tracker.window=0.3", "lines.extraction.densify_step=1e-9"])
+    with pytest.raises(InputError, match=r"lines\.robust_scale takes a finite number or none"):
+        graph_params(["lines.robust_scale=x"])
+
+
 def test_slam_set_is_refused_for_other_methods(short_clf, tmp_path):
     r = run("slam", str(short_clf), "--method", "fht", "--trajectory", str(tmp_path / "t.txt"),
-            "--set", "smooth_clouds=true")  # fmt: skip
+            "--set", "loops.min_score=0.6")  # fmt: skip
     assert r.returncode == 2 and r.stderr == (
         "fhslam: error: --set: only with --method graph; set the fht method's parameters in "
         "Python (nothing was written)\n"

@@ -46,9 +46,26 @@ from fhslam.matching import MatchParams
 from fhslam.sim import paper_world, simulate
 from fhslam.slam import GraphSlamParams
 from fhslam.slam.fht import SlamParams
-from fhslam.slam.tracker import TrackerParams
+from fhslam.slam.graph import (
+    EdgeParams,
+    GlobalSearchParams,
+    KeyframeParams,
+    LoopParams,
+    OptimiserParams,
+    TrackerParams,
+)
 
-PARAMS = (GraphSlamParams, TrackerParams, SlamParams, ExtractionParams, MatchParams)
+PARAMS = (
+    KeyframeParams,
+    TrackerParams,
+    EdgeParams,
+    LoopParams,
+    GlobalSearchParams,
+    OptimiserParams,
+    SlamParams,
+    ExtractionParams,
+    MatchParams,
+)
 """The default (graph) method's dataclasses of parameters, nested ones included."""
 
 INTERNAL = "(please report it; run again with --debug for the traceback)"
@@ -188,16 +205,16 @@ def test_nested_parameters_must_be_of_their_class():
     [
         ("tracker.window=-1", ["TrackerParams.window", ">= 0 and at most 10 m", "got -1.0"]),
         ("tracker.window=1e308", ["TrackerParams.window", "got 1e+308"]),
-        ("tracker.angle_step_deg=1e-9", ["TrackerParams.angle_step_deg", ">= 0.05"]),
-        ("tracker.max_points=10000000", ["TrackerParams.max_points", "at most 100000"]),
+        ("tracker.resolution=1e-9", ["TrackerParams.resolution", ">= 0.01"]),
+        ("tracker.refine_iterations=1000", ["TrackerParams.refine_iterations", "at most 100"]),
         ("tracker.prior_sigma=1", ["is not a number or switch"]),
-        ("loop_growth=0", ["GraphSlamParams.loop_growth", "> 0"]),
-        ("global_keyframes=0", ["GraphSlamParams.global_keyframes", ">= 1"]),
-        ("global_max_window=1e300", ["GraphSlamParams.global_max_window"]),
-        ("loop_min_score=1.5", ["GraphSlamParams.loop_min_score must be in [0, 1]"]),
-        ("optimize_tol=nan", ["optimize_tol takes a finite number"]),
-        ("submap_keyframes=2.5", ["submap_keyframes takes an integer"]),
-        ("pair_share=true", ["set pair_edges too"]),
+        ("loops.growth=0", ["LoopParams.growth", "> 0"]),
+        ("search.keyframes=0", ["GlobalSearchParams.keyframes", ">= 1"]),
+        ("search.max_window=1e300", ["GlobalSearchParams.max_window"]),
+        ("loops.min_score=1.5", ["LoopParams.min_score must be in [0, 1]"]),
+        ("optimiser.tol=nan", ["optimiser.tol takes a finite number"]),
+        ("keyframes.submap=2.5", ["keyframes.submap takes an integer"]),
+        ("loop_min_score=0.5", ["'loop_min_score' is not a number or switch"]),
     ],
 )
 def test_slam_set_out_of_range_is_one_line_naming_the_option(
@@ -212,9 +229,18 @@ def test_slam_set_out_of_range_is_one_line_naming_the_option(
 
 def test_slam_set_names_the_option_of_the_bad_one_among_several(small_log, tmp_path, capsys):
     argv = ["slam", str(small_log), "--trajectory", str(tmp_path / "t.txt"), "--quiet"]
-    argv += ["--set", "tracker.window=0.3", "--set", "tracker.sigma=0", "--set", "loop_radius=3"]
+    argv += [
+        "--set",
+        "tracker.window=0.3",
+        "--set",
+        "tracker.resolution=0",
+        "--set",
+        "loops.radius=3",
+    ]
     assert main(argv) == 2
-    one_line_error(capsys.readouterr().err, "--set 'tracker.sigma=0': TrackerParams.sigma")
+    one_line_error(
+        capsys.readouterr().err, "--set 'tracker.resolution=0': TrackerParams.resolution"
+    )
 
 
 def test_sweep_set_out_of_range_is_one_line(capsys, monkeypatch):
@@ -580,12 +606,12 @@ def test_a_user_who_cannot_write_the_package_runs_it(tmp_path):
 
 @pytest.fixture
 def broken_info(monkeypatch):
-    import fhslam.cli
+    import fhslam.cli.info
 
     def broken(args):
         raise RuntimeError("a bug\n  on two lines")
 
-    monkeypatch.setattr(fhslam.cli, "_info", broken)
+    monkeypatch.setattr(fhslam.cli.info, "run", broken)
 
 
 def test_a_bug_is_one_line_and_exit_status_1(broken_info, small_log, capsys):
@@ -618,7 +644,7 @@ def test_the_command_shows_a_bug_as_one_line_and_its_traceback_with_debug(small_
         "import sys, fhslam.cli\n"
         "def broken(args):\n"
         "    raise KeyError('lost')\n"
-        "fhslam.cli._info = broken\n"
+        "fhslam.cli.info.run = broken\n"
         "sys.exit(fhslam.cli.main(sys.argv[1:]))\n"
     )
     r = subprocess.run(
@@ -636,19 +662,19 @@ def test_the_command_shows_a_bug_as_one_line_and_its_traceback_with_debug(small_
 
 
 def test_ctrl_c_and_exits_keep_their_ways(monkeypatch, small_log, capsys):
-    import fhslam.cli
+    import fhslam.cli.info
 
     def interrupted(args):
         raise KeyboardInterrupt
 
-    monkeypatch.setattr(fhslam.cli, "_info", interrupted)
+    monkeypatch.setattr(fhslam.cli.info, "run", interrupted)
     assert main(["info", str(small_log)]) == 130
     assert capsys.readouterr().err.startswith("fhslam: interrupted")
 
     def leaves(args):
         sys.exit(3)
 
-    monkeypatch.setattr(fhslam.cli, "_info", leaves)
+    monkeypatch.setattr(fhslam.cli.info, "run", leaves)
     with pytest.raises(SystemExit) as e:
         main(["info", str(small_log)])
     assert e.value.code == 3

@@ -18,32 +18,28 @@ import pytest
 from fhslam.geometry import transform_points
 from fhslam.posegraph import PoseGraph, _chi2, edge_errors
 from fhslam.scanmatch import (
-    GRID_PAD,
     LikelihoodGrid,
     PointMap,
-    _accumulate,
-    _bounds,
-    _crop,
-    _densify_numpy,
-    _dot_columns,
-    _dot_rows,
-    _first_per_cell,
-    _fma,
-    _in_box,
-    _scan_normals_numpy,
-    _search,
-    _search_padded,
-    _smooth_scan_numpy,
-    _voxel_index_numpy,
     densify,
     refine,
     scan_normals,
     smooth_scan,
     voxel_index,
 )
+from fhslam.scanmatch.clouds import (
+    _bounds,
+    _densify_numpy,
+    _first_per_cell,
+    _scan_normals_numpy,
+    _smooth_scan_numpy,
+    _voxel_index_numpy,
+)
+from fhslam.scanmatch.grids import GRID_PAD
+from fhslam.scanmatch.refinement import _accumulate, _dot_columns, _dot_rows, _fma
+from fhslam.scanmatch.search import _crop, _in_box, _search, _search_padded
 from fhslam.sim import load_world, simulate
-from fhslam.slam import graph as graph_module
 from fhslam.slam.graph import LoopTargetCache
+from fhslam.slam.graph import worker as worker_module
 
 
 def assert_identical(a, b):
@@ -613,7 +609,7 @@ def test_loop_target_cache_evicts_least_recently_used_and_builds_point_maps_once
             built.append(1)
             return PointMap.build(points, normals)
 
-    monkeypatch.setattr(graph_module, "PointMap", CountingPointMap)
+    monkeypatch.setattr(worker_module, "PointMap", CountingPointMap)
     poses = np.random.default_rng(15).normal(size=(20, 3))
     build = _Builds()
     one = 100 * 2 * 8 * 2  # points and normals of a 100-point target

@@ -132,6 +132,7 @@ def test_the_table_names_the_runs_beyond_the_bound():
 
 def test_graph_parameters_reach_the_runs(hall, capsys):
     from fhslam.slam import GraphSlamParams
+    from fhslam.slam.graph import KeyframeParams
 
     """``--set`` (``params``): keyframes every metre instead of every half metre move the
     run; the table says so. (The printed table rounds to 0.1 mm: on one machine both runs
@@ -141,14 +142,14 @@ def test_graph_parameters_reach_the_runs(hall, capsys):
             "--range-noise", "0.001", "--jobs", "1", "--quiet"]  # fmt: skip
     assert main(args) == 0
     default = capsys.readouterr().out.splitlines()[0]
-    assert main([*args, "--set", "keyframe_distance=1.0"]) == 0
+    assert main([*args, "--set", "keyframes.distance=1.0"]) == 0
     other = capsys.readouterr().out.splitlines()[0]
     assert default.startswith(f"{path}, graph: as read ")
-    assert other.startswith(f"{path}, graph (keyframe_distance=1.0): as read ")
-    params = GraphSlamParams(keyframe_distance=1.0)
+    assert other.startswith(f"{path}, graph (keyframes.distance=1.0): as read ")
+    params = GraphSlamParams(keyframes=KeyframeParams(distance=1.0))
     kw = dict(seeds=[0], range_noise=0.001, n_jobs=1, progress=False)
     rows = log_sweep(path, relations, methods=("graph", "fht"), params=params, **kw)
-    assert [r.settings for r in rows] == ["keyframe_distance=1.0"] * 2 + [""] * 2
+    assert [r.settings for r in rows] == ["keyframes.distance=1.0"] * 2 + [""] * 2
     plain = log_sweep(path, relations, methods=("graph",), **kw)
     assert [r.trans_error for r in rows[:2]] != [r.trans_error for r in plain]
 
@@ -156,13 +157,14 @@ def test_graph_parameters_reach_the_runs(hall, capsys):
 def test_the_simulated_sweep_takes_graph_parameters_too(monkeypatch, capsys):
     from fhslam.experiments import compare
     from fhslam.slam import GraphSlamParams
+    from fhslam.slam.graph import LoopParams
 
     seen = {}
     monkeypatch.setattr(compare, "slam_sweep", lambda **kw: seen.update(kw) or [])
     monkeypatch.setattr(compare, "format_summary", lambda rows: "")
-    assert main(["sweep", "--world", "hall", "--set", "smooth_clouds=false", "--quiet"]) == 0
-    assert capsys.readouterr().out.startswith("the graph method with --set smooth_clouds=false")
-    assert seen["params"] == GraphSlamParams(smooth_clouds=False)
+    assert main(["sweep", "--world", "hall", "--set", "loops.min_score=0.6", "--quiet"]) == 0
+    assert capsys.readouterr().out.startswith("the graph method with --set loops.min_score=0.6")
+    assert seen["params"] == GraphSlamParams(loops=LoopParams(min_score=0.6))
     assert seen["methods"] == ["fht", "graph", "classical", "ekf", "odometry"]
     assert (seen["world"], seen["levels"], seen["degrade_seed"]) == (
         "hall",
@@ -180,7 +182,7 @@ def test_the_simulated_sweep_takes_graph_parameters_too(monkeypatch, capsys):
         (["--rel", "--degrade-seed", "3", "--range-noise", "0.001"], "--degrade-seed: not with"),
         (["--rel"], "nothing to vary: give a range noise"),
         (
-            ["--rel", "--range-noise", "0.001", "--methods", "fht", "--set", "smooth_clouds=1"],
+            ["--rel", "--range-noise", "0.001", "--methods", "fht", "--set", "loops.min_score=0.6"],
             "--set: only with the graph method",
         ),
         (["--rel", "--range-noise", "0.001", "--set", "nonsense=1"], "--set 'nonsense=1': "),

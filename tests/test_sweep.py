@@ -166,10 +166,11 @@ def test_the_graph_methods_settings_are_recorded_row_by_row(tmp_path):
     ``tracker.NAME``); the file reads back with them."""
     from fhslam.experiments.compare import settings_text, slam_sweep
     from fhslam.slam import GraphSlamParams
-    from fhslam.slam.tracker import TrackerParams
+    from fhslam.slam.graph import LoopParams, TrackerParams
 
-    params = GraphSlamParams(loop_target_keyframes=4, tracker=TrackerParams(window=0.3))
-    assert settings_text(params) == "tracker.window=0.3 loop_target_keyframes=4"
+    loops, tracker = LoopParams(target_keyframes=4), TrackerParams(window=0.3)
+    params = GraphSlamParams(loops=loops, tracker=tracker)
+    assert settings_text(params) == "tracker.window=0.3 loops.target_keyframes=4"
     assert settings_text(GraphSlamParams()) == settings_text(None) == ""
     rows = slam_sweep(
         "corridor", seeds=[0], levels=["low"], methods=["odometry", "graph"], n_jobs=1,
@@ -177,7 +178,7 @@ def test_the_graph_methods_settings_are_recorded_row_by_row(tmp_path):
     )  # fmt: skip
     assert [(r.method, r.settings) for r in rows] == [
         ("odometry", ""),
-        ("graph", "tracker.window=0.3 loop_target_keyframes=4"),
+        ("graph", "tracker.window=0.3 loops.target_keyframes=4"),
     ]
     save_sweep(rows, tmp_path / "s.csv")
     assert tmp_path.joinpath("s.csv").read_text().splitlines()[0].endswith(",last_bit,settings")

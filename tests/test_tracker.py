@@ -12,7 +12,7 @@ from fhslam.metrics import ate
 from fhslam.pipeline import run_slam
 from fhslam.sim import OdometryNoise, load_world, simulate
 from fhslam.slam.graph import GraphFastHoughSLAM
-from fhslam.slam.tracker import TrackerParams
+from fhslam.slam.graph.tracker import TrackerParams
 
 
 @pytest.fixture(scope="module")
@@ -53,10 +53,10 @@ def test_tracker_parameters_are_checked():
         TrackerParams(resolution=0.0)
     with pytest.raises(ValueError, match=r"min_score must be in \[0, 1\]"):
         TrackerParams(min_score=2.0)
-    with pytest.raises(ValueError, match="prior_sigma must be two values > 0"):
-        TrackerParams(prior_sigma=(0.05, 0.0))
-    with pytest.raises(ValueError, match="residual_sigma must be > 0"):
-        TrackerParams(residual_sigma=-1.0)
+    with pytest.raises(ValueError, match="window must be >= 0"):
+        TrackerParams(window=-0.1)
+    with pytest.raises(ValueError, match=r"recovery_window_deg must be in \[0, 180\]"):
+        TrackerParams(recovery_window_deg=181.0)
     with pytest.raises(ValueError, match="refine_iterations must be >= 1"):
         TrackerParams(refine_iterations=0)
 
@@ -82,10 +82,10 @@ def test_after_a_doubtful_scan_the_wide_search_starts_where_the_odometry_is_plau
     the odometry prior (on the Freiburg hospital log, centring it on the previous pose let
     poor scans jump 0.5-0.7 m and 10-25 degrees); only an implausible increment (a glitch)
     centres it on the previous pose, as if the robot stood still, and drops the prior."""
-    import fhslam.slam.tracker as tracker_module
+    import fhslam.slam.graph.tracker as tracker_module
     from fhslam.geometry import transform_points
     from fhslam.scanmatch import scan_normals
-    from fhslam.slam.tracker import ScanTracker
+    from fhslam.slam.graph.tracker import ScanTracker
 
     world = _room_points()
     tr = ScanTracker()
@@ -120,7 +120,7 @@ def test_turning_into_unseen_space_the_previous_scan_places_the_scan():
     the relation error from 0.73 m to 0.028 m)."""
     from fhslam.geometry import transform_points
     from fhslam.scanmatch import scan_normals
-    from fhslam.slam.tracker import ScanTracker
+    from fhslam.slam.graph.tracker import ScanTracker
 
     world = _room_points()
 
@@ -150,7 +150,7 @@ def test_a_straight_corridor_with_perfect_odometry_keeps_its_heading():
     and which noisy point each 2 cm cell keeps tilts every keyframe's walls the same way:
     1.11, 0.83, 1.36 and 1.00° over
     seeds 0-3 unless each scan is smoothed along its beams before it enters a cloud
-    (``smooth_clouds``, the default; tests/test_graphslam.py compares both).
+    (:func:`fhslam.slam.graph.scan_cloud`).
     Without range noise it ends 0.05° off, with the correlative search alone 0.00° (it
     keeps the prediction)."""
     log = simulate(load_world("ring"), seed=0, odometry=OdometryNoise.none(), max_scans=480)

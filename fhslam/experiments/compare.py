@@ -77,7 +77,7 @@ class RunResult:
 
 def settings_text(params: object | None, prefix: str = "") -> str:
     """The fields of a parameter dataclass that differ from its defaults, as ``fhslam slam
-    --set`` names them: ``"tracker.window=0.3 loop_target_keyframes=4"`` (a nested parameter
+    --set`` names them: ``"tracker.window=0.3 loops.target_keyframes=4"`` (a nested parameter
     dataclass, such as :class:`~fhslam.slam.GraphSlamParams`'s ``tracker``, field by field);
     empty for ``None`` or the defaults."""
     if params is None:

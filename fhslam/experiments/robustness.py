@@ -70,7 +70,7 @@ class LogRun:
     seconds: float
     settings: str = ""
     """The ``graph`` method's parameters that differ from their defaults, as ``--set``
-    names them (``"loop_target_keyframes=4 tracker.window=0.3"``: :func:`~fhslam.experiments.
+    names them (``"tracker.window=0.3 loops.target_keyframes=4"``: :func:`~fhslam.experiments.
     compare.settings_text`; empty: the defaults, or another method)."""
 
     @property

@@ -52,6 +52,33 @@ from fhslam.scanmatch import (
 __all__ = ["ScanTracker", "Track", "TrackerParams"]
 
 
+# Fixed by the method (measured; not parameters):
+SIGMA = 0.08
+"""Width of the likelihood grid's ``exp(-d²/2σ²)``, metres."""
+ANGLE_STEP_DEG = 0.5
+"""Heading step of the correlative search, degrees."""
+TURN_FRACTION = 0.3
+"""The search's heading window grows by this fraction of the odometry's turn."""
+SEARCH_PRIOR = (0.5, 0.05)
+"""Score given up per metre and per radian from the prediction: of near-equal scores (along
+a corridor's axis) the one nearest the prediction wins."""
+MAX_STEP = 0.4
+"""An odometry increment longer than this (metres)..."""
+MAX_TURN_DEG = 25.0
+"""... or turning more than this (degrees) is a glitch: the recovery search runs."""
+QUERY_VOXEL = 0.05
+"""The scan is thinned to one point per cell of this size (metres)..."""
+MAX_POINTS = 250
+"""... and to at most this many points."""
+REFINE_DISTANCE = 0.15
+"""Point-to-line pairs farther apart than this (metres) are not formed."""
+PRIOR_SIGMA = (0.05, 10.0)
+"""The odometry prediction enters the refinement as a prior of this standard deviation
+(metres, degrees), relative to a point-to-line residual of ``RESIDUAL_SIGMA`` metres: where
+the scan says nothing (a corridor's axis) the odometry is kept."""
+RESIDUAL_SIGMA = 0.03
+
+
 @dataclass(frozen=True)
 class TrackerParams:
     """Parameters of :class:`ScanTracker`.
@@ -59,98 +86,48 @@ class TrackerParams:
     Attributes
     ----------
     resolution : float
-        Cell of the correlative search's likelihood grid, metres (its translation step).
-    sigma : float
-        Width of the grid's likelihood ``exp(-d²/2σ²)``, metres.
-    angle_step_deg : float
-        Heading step of the correlative search, degrees.
+        Cell of the correlative search's likelihood grid (its translation step), metres.
     window : float
         Search ``± window`` metres around the odometry prediction...
     window_deg : float
-        ... and ``± window_deg`` degrees plus ``turn_fraction`` of the odometry's turn.
-    turn_fraction : float
-        See ``window_deg``.
-    search_prior : (float, float)
-        Score given up per metre and per radian of distance from the prediction in that
-        search: of near-equal scores (a corridor's axis) the one nearest the prediction wins.
+        ... and ``± window_deg`` degrees (plus a share of the odometry's turn).
     recovery_window : float
         The search around the previous pose (see the module docs), ± metres...
     recovery_window_deg : float
         ... and ± degrees.
-    max_step : float
-        An odometry increment longer than this (metres)...
-    max_turn_deg : float
-        ... or turning more than this (degrees) also triggers the recovery search.
     min_score : float
         A match scoring less (mean likelihood of the scan's points, 0..1) is not used.
     sure_score : float
-        A match scoring less is used but not *sure* (:attr:`Track.sure`): the next scan's
-        search includes the recovery search, and the caller should not build on it.
-    query_voxel : float
-        The scan is thinned to one point per cell of this size (metres)...
-    max_points : int
-        ... and to at most this many points.
-    refine_distance : float
-        Point-to-line pairs farther apart than this (metres) are not formed.
+        A match scoring less is used but not *sure* (:attr:`Track.sure`): the next scan
+        searches widely again, and the graph builds nothing on it.
     refine_iterations : int
-        Rounds of the refinement (each pairs every point anew and takes a Gauss-Newton
-        step; the last only measures). The four steps that ten rounds added moved a pose by
-        0.35, 0.24, 0.18 and 0.11 mm (medians on MIT CSAIL), under the spread of the map's
-        own points; with six no relation error on the shared logs changed by more than 2 %.
-    prior_sigma : (float, float)
-        The odometry prediction enters the refinement as a prior of this standard deviation
-        (metres, degrees), relative to a point-to-line residual of ``residual_sigma``: where
-        the scan says nothing (a corridor's axis) the odometry is kept.
-    residual_sigma : float
-        See ``prior_sigma``, metres.
+        Rounds of the point-to-line refinement (each pairs the points anew and takes a
+        Gauss-Newton step; the last only measures).
     """
 
     resolution: float = 0.05
-    sigma: float = 0.08
-    angle_step_deg: float = 0.5
     window: float = 0.2
     window_deg: float = 3.0
-    turn_fraction: float = 0.3
-    search_prior: tuple[float, float] = (0.5, 0.05)
     recovery_window: float = 0.6
     recovery_window_deg: float = 45.0
-    max_step: float = 0.4
-    max_turn_deg: float = 25.0
     min_score: float = 0.45
     sure_score: float = 0.6
-    query_voxel: float = 0.05
-    max_points: int = 250
-    refine_distance: float = 0.15
     refine_iterations: int = 6
-    prior_sigma: tuple[float, float] = (0.05, 10.0)
-    residual_sigma: float = 0.03
 
     RANGES: ClassVar[dict[str, Range]] = {
         "resolution": Range(0.01, 1.0, unit="m"),
-        "sigma": Range(0.001, 5.0, unit="m"),
-        "angle_step_deg": Range(0.05, 45.0, unit="degrees"),
         "window": Range(0.0, 10.0, unit="m"),
         "window_deg": Range(0.0, 180.0, cap=False, unit="degrees"),
-        "turn_fraction": Range(0.0, 10.0),
-        "search_prior": Range(0.0, 1000.0, items=2),
         "recovery_window": Range(0.0, 20.0, unit="m"),
         "recovery_window_deg": Range(0.0, 180.0, cap=False, unit="degrees"),
-        "max_step": Range(0.0, 100.0, unit="m"),
-        "max_turn_deg": Range(0.0, 360.0, cap=False, unit="degrees"),
         "min_score": Range(0.0, 1.0, cap=False),
         "sure_score": Range(0.0, 1.0, cap=False),
-        "query_voxel": Range(0.001, 1.0, unit="m"),
-        "max_points": Range(1, 100_000, integer=True),
-        "refine_distance": Range(0.0, 10.0, open_low=True, unit="m"),
         "refine_iterations": Range(1, 100, integer=True),
-        "prior_sigma": Range(0.0, 1000.0, open_low=True, items=2),
-        "residual_sigma": Range(0.0, 1.0, open_low=True, unit="m"),
     }
     """The range of each number (:class:`fhslam.errors.Range`), checked when the parameters
-    are made. The upper bounds of lengths, angle steps and counts are limits of
-    plausibility: past them a search's grid or loop outgrows any machine. The lower bounds
-    of ``resolution``, ``sigma``, ``angle_step_deg`` and ``query_voxel`` likewise (a grid
-    finer than 1 cm over a local map of 50 m holds more than 25 million cells)."""
+    are made. The upper bounds of lengths and counts are limits of plausibility: past them a
+    search's grid or loop outgrows any machine; so is the lower bound of ``resolution`` (a
+    grid finer than 1 cm over a local map of 50 m holds more than 25 million cells)."""
 
     def __post_init__(self) -> None:
         check_ranges(self, self.RANGES)
@@ -192,12 +169,12 @@ class ScanTracker:
         """Use ``points`` (in the tracking frame) with their ``normals`` (NaN: none; see
         :func:`fhslam.scanmatch.scan_normals`) as the local map from now on."""
         p = self.params
-        margin = p.recovery_window + 3 * p.sigma
+        margin = p.recovery_window + 3 * SIGMA
         pts = voxel_downsample(points, p.resolution / 2)
         if len(pts) < 10:
             self._grid = self._points = None
             return
-        self._grid = LikelihoodGrid.build(pts, p.resolution, p.sigma, margin)
+        self._grid = LikelihoodGrid.build(pts, p.resolution, SIGMA, margin)
         self._points = PointMap.build(points, normals)
 
     def track(
@@ -211,25 +188,25 @@ class ScanTracker:
         p = self.params
         predicted = as_pose(predicted, "predicted")
         last, self._last = self._last, None
-        q = _thin(voxel_downsample(points, p.query_voxel), p.max_points)
+        q = _thin(voxel_downsample(points, QUERY_VOXEL), MAX_POINTS)
         if self._grid is None or len(q) < 10:
             self._doubt = True
             return Track(predicted, 0.0, False, False, False, None)
         step = previous[:2] - predicted[:2]
         turn = abs(np.degrees(np.angle(np.exp(1j * (predicted[2] - previous[2])))))
-        da = np.radians(p.angle_step_deg)
+        da = np.radians(ANGLE_STEP_DEG)
         score, pose = correlative_search(
             self._grid,
             q,
             predicted,
             p.window,
-            np.radians(p.window_deg + p.turn_fraction * turn),
+            np.radians(p.window_deg + TURN_FRACTION * turn),
             da,
-            p.search_prior,
+            SEARCH_PRIOR,
         )
         recovered = False
         doubt, self._doubt = self._doubt, True
-        glitch = np.hypot(*step) > p.max_step or turn > p.max_turn_deg
+        glitch = np.hypot(*step) > MAX_STEP or turn > MAX_TURN_DEG
         if doubt or score < p.sure_score or glitch:
             s2, pose2 = correlative_search(
                 self._grid,
@@ -238,7 +215,7 @@ class ScanTracker:
                 p.recovery_window,
                 np.radians(p.recovery_window_deg),
                 da,
-                (0.05, 0.05) if glitch else p.search_prior,
+                (0.05, 0.05) if glitch else SEARCH_PRIOR,
             )
             if s2 > score + 0.02:
                 score, pose, recovered = s2, pose2, glitch
@@ -252,8 +229,8 @@ class ScanTracker:
             grid = LikelihoodGrid.build(
                 voxel_downsample(cloud, p.resolution / 2),
                 p.resolution,
-                p.sigma,
-                p.recovery_window + 3 * p.sigma,
+                SIGMA,
+                p.recovery_window + 3 * SIGMA,
             )
             s3, pose3 = correlative_search(
                 grid,
@@ -262,18 +239,18 @@ class ScanTracker:
                 p.recovery_window,
                 np.radians(p.recovery_window_deg),
                 da,
-                (0.05, 0.05) if glitch else p.search_prior,
+                (0.05, 0.05) if glitch else SEARCH_PRIOR,
             )
             if s3 >= p.sure_score and s3 > score:
                 score, pose, recovered = s3, pose3, glitch
                 target = PointMap.build(cloud, normals)
         if score < p.min_score:
             return Track(predicted, score, False, False, False, None)
-        s_xy, s_deg = p.prior_sigma
-        info = p.residual_sigma**2 * np.diag([1 / s_xy**2, 1 / s_xy**2, 1 / np.radians(s_deg) ** 2])
+        s_xy, s_deg = PRIOR_SIGMA
+        info = RESIDUAL_SIGMA**2 * np.diag([1 / s_xy**2, 1 / s_xy**2, 1 / np.radians(s_deg) ** 2])
         # after a glitch (recovered) the prediction is wrong: no prior then
         prior = None if recovered else (predicted, info)
-        ref = refine(target, points, pose, p.refine_distance, p.refine_iterations, prior=prior)
+        ref = refine(target, points, pose, REFINE_DISTANCE, p.refine_iterations, prior=prior)
         if ref.n_matched >= 10 and np.hypot(*(ref.pose[:2] - pose[:2])) <= p.window:
             pose = ref.pose
         self._doubt = score < p.sure_score

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import os
+import time
 from pathlib import Path
 
 import numpy as np
@@ -64,6 +65,9 @@ def paper_log_small():
 # couple of minutes on 2 cores. ``--all-tiers`` adds the slow tier (whole logs, sweeps,
 # goldens, notebooks run in a kernel, the browser); with ``--nbval-lax`` the notebooks too.
 # ``-m`` selects by marker as usual (``-m slow``, ``-m browser``) and overrides the default.
+# The README's command runs the files on every core, a file to a worker (pytest-xdist,
+# ``-n auto --dist loadfile``): a notebook's cells share one kernel, in order, and a module's
+# whole-log runs cached for its tests are made once.
 
 SLOW_MODULES = {
     "test_browser.py",  # JupyterLab in headless Chromium
@@ -71,7 +75,6 @@ SLOW_MODULES = {
     "test_graphslam.py",  # every real log with the default SLAM, and its degradations
     "test_invariance.py",  # the default SLAM on worlds moved and turned
     "test_log_sweep.py",  # degraded copies of logs, in parallel
-    "test_refinement_bias.py",  # many refinements along a corridor
     "test_sweep.py",  # seeds x noise levels x methods
     "test_unseen_worlds.py",  # random worlds driven three laps
 }
@@ -113,6 +116,7 @@ SLOW_TESTS = {  # each over a second or so on 2 cores (pytest --durations)
     "test_hostile_errors.py::test_bytes_damaged_across_a_small_bag_end_cleanly",
     "test_hostile_errors.py::test_no_writable_cache_folder_at_all_compiles_without_one_saying_so_once",
     "test_hostile_inputs.py::test_a_log_with_gigabytes_of_nul_bytes_is_read_in_bounded_memory",
+    "test_house.py::test_readme_command_line_examples_run",
     "test_house.py::test_readme_python_example_runs",
     "test_kernels.py::test_graph_slam_gives_the_same_poses_with_and_without_the_loop_target_cache",
     "test_kernels.py::test_likelihood_grid_equals_opencv_construction",
@@ -163,13 +167,15 @@ def pytest_addoption(parser):
 
 
 class _TierClock:
-    """Adds up each tier's test time (setup, call, teardown), for the summary's line. A
-    plugin of its own, so that it also hears the notebooks' cells, which lie outside
-    ``tests/`` and so outside this file's hooks."""
+    """Adds up each tier's test time (setup, call, teardown), for the summary's line, and
+    the run's wall time (with ``-n``, pytest-xdist's workers run tests side by side, so
+    the tiers' times add up to more than it). A plugin of its own, so that it also hears
+    the notebooks' cells, which lie outside ``tests/`` and so outside this file's hooks."""
 
     def __init__(self) -> None:
         self.seconds = dict.fromkeys(TIERS, 0.0)
         self.counts = dict.fromkeys(TIERS, 0)
+        self.start = time.perf_counter()
 
     def pytest_runtest_logreport(self, report) -> None:
         tier = _tier(report.nodeid)
@@ -180,8 +186,11 @@ class _TierClock:
     def pytest_terminal_summary(self, terminalreporter) -> None:
         ran = [(t, self.counts[t], self.seconds[t]) for t in TIERS if self.counts[t]]
         if ran:
+            wall = (time.perf_counter() - self.start) / 60
             terminalreporter.write_line(
-                "tiers: " + ", ".join(f"{t} {n} tests in {s / 60:.1f} min" for t, n, s in ran)
+                "tiers: "
+                + ", ".join(f"{t} {n} tests in {s / 60:.1f} min" for t, n, s in ran)
+                + f"; wall {wall:.1f} min"
             )
 
 
@@ -189,7 +198,8 @@ def pytest_configure(config):
     config.addinivalue_line("markers", "slow: the slow tier (whole logs, sweeps, goldens)")
     config.addinivalue_line("markers", "browser: the browser tier (JupyterLab in Chromium)")
     config.addinivalue_line("markers", "notebooks: the notebooks under nbval")
-    config.pluginmanager.register(_TierClock(), "fhslam-tier-clock")
+    if not hasattr(config, "workerinput"):  # the controller (or a run without xdist)
+        config.pluginmanager.register(_TierClock(), "fhslam-tier-clock")
 
 
 def pytest_collection_modifyitems(config, items):

@@ -246,15 +246,6 @@ def test_bench_profile_prints_where_the_time_goes(short_clf):
     assert "Ordered by: cumulative time" in r.stderr and "run_log_bench" in r.stderr
 
 
-def test_slam_profile_prints_where_the_time_goes(short_clf, tmp_path):
-    traj = tmp_path / "t.txt"
-    r = run("slam", str(short_clf), "--trajectory", str(traj), "--quiet", "--profile")
-    assert r.returncode == 0, r.stderr
-    assert r.stdout.startswith("wrote 60 poses")
-    assert "cumulative" in r.stderr and "run_slam" in r.stderr
-    assert len(read_trajectory(traj)[0]) == 60
-
-
 @pytest.mark.parametrize("scans", ["0", "-5"])
 def test_bench_bad_scans_is_one_line_exit_2(short_clf, scans):
     for argv in (["bench", "--log", str(short_clf), "--scans", scans], ["bench", "--scans", scans]):

@@ -10,13 +10,11 @@ import warnings
 from pathlib import Path
 
 from fhslam.cli.common import (
-    PROFILE_HELP,
     add_method_argument,
     degrade_arguments,
     graph_params,
     log_arguments,
     plot_format,
-    profiling,
     random_seed,
     read_log,
     save_figure,
@@ -66,7 +64,6 @@ def add_parser(sub) -> argparse.ArgumentParser:
         "e.g. --set loops.min_score=0.6 --set search.every=0; the trajectory's header records it",
     )
     p.add_argument("--quiet", action="store_true", help="no progress bar")
-    p.add_argument("--profile", action="store_true", help=PROFILE_HELP)
     g = p.add_argument_group(
         "robustness checks",
         "degrade the log before the run (fhslam.sim.degrade, fhslam.sim.perturb_odometry); "
@@ -86,7 +83,6 @@ def add_parser(sub) -> argparse.ArgumentParser:
 
 def run(args: argparse.Namespace) -> None:
     """Run ``args.method`` over the log and write its outputs, all or none."""
-    import fhslam.datasets  # noqa: F401  (imported before --profile starts: not what it shows)
     from fhslam.errors import InputWarning
     from fhslam.io.files import check_outputs, writes_to_stdout
     from fhslam.pipeline import keyframe_graph, make_backend, run_backend, run_slam
@@ -105,31 +101,30 @@ def run(args: argparse.Namespace) -> None:
     plot_format(args.plot)
     # an output on standard output gets it alone: the messages go to stderr then
     report = sys.stderr if writes_to_stdout(args.trajectory, args.map, args.graph) else sys.stdout
-    with profiling(args.profile):
-        log = read_log(args)
-        log, degraded = _degraded(log, args)
-        if degraded:
-            print(f"{args.log}: {degraded}", file=report)
-        if len(log) == 1:
-            warnings.warn(
-                f"{args.log}: a single scan: nothing to match it with; the trajectory is its "
-                "odometry pose",
-                InputWarning,
-                stacklevel=1,
-            )
-        progress = not args.quiet and len(log) > 200
-        graph = None
-        if args.method != "graph" or (args.graph is None and args.plot is None):
-            result = run_slam(log, args.method, params, progress=progress)
-        else:
-            backend = make_backend(args.method, params)
-            result = run_backend(backend, log, progress, desc=f"{args.method} {log.name}")
-            graph = keyframe_graph(backend, log)
-        wrote = _write_outputs(args, log, result, graph, degraded)
-        print(
-            "wrote " + ", ".join(wrote[:-1]) + (" and " if len(wrote) > 1 else "") + wrote[-1],
-            file=report,
+    log = read_log(args)
+    log, degraded = _degraded(log, args)
+    if degraded:
+        print(f"{args.log}: {degraded}", file=report)
+    if len(log) == 1:
+        warnings.warn(
+            f"{args.log}: a single scan: nothing to match it with; the trajectory is its "
+            "odometry pose",
+            InputWarning,
+            stacklevel=1,
         )
+    progress = not args.quiet and len(log) > 200
+    graph = None
+    if args.method != "graph" or (args.graph is None and args.plot is None):
+        result = run_slam(log, args.method, params, progress=progress)
+    else:
+        backend = make_backend(args.method, params)
+        result = run_backend(backend, log, progress, desc=f"{args.method} {log.name}")
+        graph = keyframe_graph(backend, log)
+    wrote = _write_outputs(args, log, result, graph, degraded)
+    print(
+        "wrote " + ", ".join(wrote[:-1]) + (" and " if len(wrote) > 1 else "") + wrote[-1],
+        file=report,
+    )
 
 
 def _checked_params(args: argparse.Namespace):

@@ -315,7 +315,6 @@ def densify(
     step: float = 0.02,
     max_gap: float = 0.1,
     max_gap_per_metre: float = 0.03,
-    corner_deg: float | None = None,
 ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """A scan (laser frame, beam order) with points filled in every ``step`` metres between
     consecutive beams that lie on one surface (closer than ``max_gap + max_gap_per_metre ×
@@ -325,13 +324,6 @@ def densify(
     line that a likelihood grid scores low wherever a query point falls between the dots;
     filled in, it scores as the wall it is.
 
-    With ``corner_deg``, the points filled in across a chord that turns by more than
-    ``corner_deg`` from both neighbouring chords (or has none) get no normal (NaN): such a
-    chord joins two surfaces, cutting a corner, and its points lie off both (behind a
-    convex corner, in front of a concave one), by centimetres where the beams are far
-    apart. They are still points (a likelihood grid scores them); a point-to-line match
-    (:class:`fhslam.scanmatch.PointMap`) leaves them out.
-
     Compiled (:func:`_densify`), with NumPy's operations in its order: the same points and
     normals, bit for bit.
     """
@@ -339,33 +331,14 @@ def densify(
     nrm = np.asarray(normals, dtype=float).reshape(-1, 2)
     if len(nrm) != len(p):
         raise ValueError(f"{len(nrm)} normals for {len(p)} points")
-    if corner_deg is not None and not 0 < corner_deg <= 90:
-        raise ValueError(f"corner_deg must be in (0, 90] degrees, got {corner_deg}")
     if len(p) < 2:
         return p, nrm
-    dense, dense_normals, k, linked = _densify(
+    dense, dense_normals, _, _ = _densify(
         p, nrm, float(step), float(max_gap), float(max_gap_per_metre)
     )
     if len(dense) == len(p):
         return p, nrm
-    if corner_deg is not None:
-        corner = _corner_chords(p, linked, corner_deg) & (k > 0)
-        dense_normals[len(p) :][np.repeat(corner, k)] = np.nan
     return dense, dense_normals
-
-
-def _corner_chords(p, linked, corner_deg):
-    """Which chords between consecutive points ``p`` turn by more than ``corner_deg`` from
-    each neighbour on the same surface (``linked``: closer than :func:`densify`'s gap), or
-    have no such neighbour."""
-    d = np.diff(p, axis=0)
-    u = d / np.maximum(np.hypot(*d.T), 1e-300)[:, None]
-    straight = linked[1:] & linked[:-1]
-    straight &= np.abs((u[1:] * u[:-1]).sum(1)) >= np.cos(np.radians(corner_deg))
-    along = np.zeros(len(d), bool)
-    along[:-1] |= straight
-    along[1:] |= straight
-    return ~along
 
 
 @njit(cache=True, nogil=True)
@@ -396,9 +369,7 @@ def _densify(p, nrm, step, max_gap, max_gap_per_metre):  # pragma: no cover
     return out_p, out_n, k, linked
 
 
-def _densify_numpy(
-    points, normals, step=0.02, max_gap=0.1, max_gap_per_metre=0.03, corner_deg=None
-):
+def _densify_numpy(points, normals, step=0.02, max_gap=0.1, max_gap_per_metre=0.03):
     """:func:`densify` in NumPy (the kernel's reference in the tests)."""
     p = as_points(points, "points")
     nrm = np.asarray(normals, dtype=float).reshape(-1, 2)
@@ -416,6 +387,4 @@ def _densify_numpy(
     fill = p[pair] + t[:, None] * d[pair]
     u = d[pair] / gap[pair, None]
     fill_normals = np.column_stack([-u[:, 1], u[:, 0]])
-    if corner_deg is not None:
-        fill_normals[_corner_chords(p, linked, corner_deg)[pair]] = np.nan
     return np.vstack([p, fill]), np.vstack([nrm, fill_normals])

@@ -81,6 +81,8 @@ SLOW_MODULES = {
 """Test modules of the slow tier, whole."""
 
 SLOW_TESTS = {  # each over a second or so on 2 cores (pytest --durations)
+    "test_benchmark.py::test_a_rerun_of_the_shortest_log_gives_the_committed_row",
+    "test_benchmark.py::test_a_rerun_draws_the_world_again_and_keeps_the_log_draws",
     "test_cli.py::test_an_output_never_overwrites_an_input",
     "test_cli.py::test_bench_bad_scans_is_one_line_exit_2",
     "test_cli.py::test_bench_profile_prints_where_the_time_goes",

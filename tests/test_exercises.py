@@ -22,7 +22,11 @@ from fhslam.cli import main
 from fhslam.exercises import Feedback, Wrong, call, check_choice, check_value, exercise
 from fhslam.workbook import SOLUTION_NOTE, STUDENT_NOTE
 
-NOTEBOOKS = sorted((Path(__file__).parents[1] / "notebooks").glob("[0-9][0-9]_*.ipynb"))
+ALL_NOTEBOOKS = sorted((Path(__file__).parents[1] / "notebooks").glob("[0-9][0-9]_*.ipynb"))
+RESEARCH = {"09_benchmarks.ipynb"}
+"""Notebooks of measurements, not lessons: no exercises."""
+NOTEBOOKS = [p for p in ALL_NOTEBOOKS if p.name not in RESEARCH]
+"""The teaching notebooks, 01-08: each with its exercises."""
 HEADING = re.compile(r"## Exercise (\d+)\.(\d+) \((predict|implement|interpret)\) — \S")
 
 
@@ -72,8 +76,9 @@ def defined(source: str) -> set[str]:
     return found
 
 
-def test_all_eight_notebooks_are_found():
+def test_the_eight_teaching_notebooks_and_the_benchmarks_are_found():
     assert [p.name[:2] for p in NOTEBOOKS] == [f"{k:02d}" for k in range(1, 9)]
+    assert [p.name for p in ALL_NOTEBOOKS if p not in NOTEBOOKS] == sorted(RESEARCH)
 
 
 @pytest.mark.parametrize("path", NOTEBOOKS, ids=lambda p: p.name[:2])
@@ -187,8 +192,8 @@ def test_student_copy_removes_every_solution_and_output(tmp_path, capsys):
     out = tmp_path / "class"
     assert main(["student-copy", str(out), "--notebooks", str(NOTEBOOKS[0].parent)]) == 0
     lines = capsys.readouterr().out.splitlines()
-    assert len(lines) == len(NOTEBOOKS)
-    for path in NOTEBOOKS:
+    assert len(lines) == len(ALL_NOTEBOOKS)
+    for path in ALL_NOTEBOOKS:
         original = nbformat.read(path, as_version=4)
         copy = nbformat.read(out / path.name, as_version=4)
         n = sum("solution" in tags(c) for c in original.cells)

@@ -25,6 +25,7 @@ import warnings
 
 from fhslam.cli import (
     bench,
+    benchmark,
     evaluate,
     info,
     reproduce,
@@ -48,7 +49,18 @@ from fhslam.cli.exits import (
 
 __all__ = ["COMMANDS", "WORLDS_HELP", "build_parser", "main"]
 
-COMMANDS = (simulate, slam, info, evaluate, reproduce, bench, sweep, student_copy, run_notebooks)
+COMMANDS = (
+    simulate,
+    slam,
+    info,
+    evaluate,
+    reproduce,
+    bench,
+    benchmark,
+    sweep,
+    student_copy,
+    run_notebooks,
+)
 """The commands' modules, in the order of the help."""
 
 DEBUG_HELP = "show the traceback of an internal error (a bug) instead of its one line"

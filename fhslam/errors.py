@@ -19,6 +19,7 @@ import math
 import numbers
 from collections.abc import Mapping
 from dataclasses import dataclass
+from typing import ClassVar
 
 __all__ = [
     "InputError",
@@ -26,6 +27,7 @@ __all__ = [
     "MissingInputError",
     "ParameterError",
     "Range",
+    "Ranged",
     "check_ranges",
 ]
 
@@ -139,3 +141,13 @@ def check_ranges(params: object, ranges: Mapping[str, Range]) -> None:
     owner = type(params).__name__
     for name, allowed in ranges.items():
         allowed.check(owner, name, getattr(params, name))
+
+
+class Ranged:
+    """A base of frozen dataclasses of parameters whose numbers are all checked against the
+    class's ``RANGES`` (:func:`check_ranges`) when an instance is made."""
+
+    RANGES: ClassVar[dict[str, Range]] = {}
+
+    def __post_init__(self) -> None:
+        check_ranges(self, self.RANGES)

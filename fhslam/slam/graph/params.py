@@ -20,7 +20,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field, fields, is_dataclass
 from typing import ClassVar
 
-from fhslam.errors import ParameterError, Range, check_ranges
+from fhslam.errors import ParameterError, Range, Ranged
 from fhslam.slam.fht import SlamParams
 from fhslam.slam.graph.tracker import TrackerParams
 
@@ -37,7 +37,7 @@ __all__ = [
 
 
 @dataclass(frozen=True)
-class KeyframeParams:
+class KeyframeParams(Ranged):
     """When a keyframe starts, and what its cloud of points keeps.
 
     Attributes
@@ -68,12 +68,9 @@ class KeyframeParams:
         "submap": Range(1, 1000, integer=True),
     }
 
-    def __post_init__(self) -> None:
-        check_ranges(self, self.RANGES)
-
 
 @dataclass(frozen=True)
-class EdgeParams:
+class EdgeParams(Ranged):
     """The information of an edge between consecutive keyframes.
 
     Attributes
@@ -97,12 +94,9 @@ class EdgeParams:
         "odometry_sigma": Range(0.0, 1000.0, open_low=True, items=2),
     }
 
-    def __post_init__(self) -> None:
-        check_ranges(self, self.RANGES)
-
 
 @dataclass(frozen=True)
-class LoopParams:
+class LoopParams(Ranged):
     """The local loop-closure search (:mod:`fhslam.slam.graph.closure`).
 
     Attributes
@@ -163,12 +157,9 @@ class LoopParams:
         "consistency": Range(0.0, 100.0, open_low=True, unit="m"),
     }
 
-    def __post_init__(self) -> None:
-        check_ranges(self, self.RANGES)
-
 
 @dataclass(frozen=True)
-class GlobalSearchParams:
+class GlobalSearchParams(Ranged):
     """The global search for a place seen long ago (:mod:`fhslam.slam.graph.search`).
 
     Attributes
@@ -208,12 +199,9 @@ class GlobalSearchParams:
         "max_window": Range(0.0, 500.0, open_low=True, unit="m"),
     }
 
-    def __post_init__(self) -> None:
-        check_ranges(self, self.RANGES)
-
 
 @dataclass(frozen=True)
-class OptimiserParams:
+class OptimiserParams(Ranged):
     """The Gauss-Newton optimisation of the pose graph (:class:`fhslam.posegraph.PoseGraph`).
 
     Attributes
@@ -231,9 +219,6 @@ class OptimiserParams:
         "iterations": Range(1, 1000, integer=True),
         "tol": Range(0.0, 1.0),
     }
-
-    def __post_init__(self) -> None:
-        check_ranges(self, self.RANGES)
 
 
 @dataclass(frozen=True)

@@ -36,7 +36,7 @@ from typing import ClassVar
 import numpy as np
 from numpy.typing import NDArray
 
-from fhslam.errors import Range, check_ranges
+from fhslam.errors import Range, Ranged
 from fhslam.geometry import as_pose, transform_points
 from fhslam.scanmatch import (
     LikelihoodGrid,
@@ -80,7 +80,7 @@ RESIDUAL_SIGMA = 0.03
 
 
 @dataclass(frozen=True)
-class TrackerParams:
+class TrackerParams(Ranged):
     """Parameters of :class:`ScanTracker`.
 
     Attributes
@@ -128,9 +128,6 @@ class TrackerParams:
     are made. The upper bounds of lengths and counts are limits of plausibility: past them a
     search's grid or loop outgrows any machine; so is the lower bound of ``resolution`` (a
     grid finer than 1 cm over a local map of 50 m holds more than 25 million cells)."""
-
-    def __post_init__(self) -> None:
-        check_ranges(self, self.RANGES)
 
 
 @dataclass(frozen=True)

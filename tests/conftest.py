@@ -60,14 +60,42 @@ def paper_log_small():
     return simulate(paper_world(), seed=0, max_scans=20)
 
 
+def blind_turn(log, degrees, before, blind, after):
+    """``log`` (a route driven twice) cut ``after`` metres into its second lap, blind for
+    ``blind`` scans (every range NaN) from ``before`` metres ahead of the first lap's end,
+    while its odometry turns ``degrees`` too far (spread over the blind scans, kept after):
+    the estimate comes back to the start turned and shifted by an amount no scan could
+    correct on the way."""
+    from dataclasses import replace
+
+    from fhslam.geometry import compose, relative
+
+    travelled = np.concatenate([[0.0], np.cumsum(np.hypot(*np.diff(log.truth[:, :2], axis=0).T))])
+    lap = travelled[-1] / 2
+    a = int(np.searchsorted(travelled, lap - before))
+    end = int(np.searchsorted(travelled, lap + after))
+    odometry = log.odometry.copy()
+    for k in range(a, len(odometry)):
+        turn = np.radians(degrees) * min(1.0, (k - a) / blind)
+        odometry[k] = compose(
+            log.odometry[a], compose([0, 0, turn], relative(log.odometry[a], log.odometry[k]))
+        )
+    ranges = log.ranges.copy()
+    ranges[a : a + blind] = np.nan
+    return replace(
+        log, timestamps=log.timestamps[:end], ranges=ranges[:end], odometry=odometry[:end],
+        truth=log.truth[:end], hits=None if log.hits is None else log.hits[:end],
+    )  # fmt: skip
+
+
 # --------------------------------------------------------------------------------------------
 # Tiers. Plain ``pytest`` runs the fast tier: unit, property, small CLI and file tests, a
 # couple of minutes on 2 cores. ``--all-tiers`` adds the slow tier (whole logs, sweeps,
 # goldens, notebooks run in a kernel, the browser); with ``--nbval-lax`` the notebooks too.
 # ``-m`` selects by marker as usual (``-m slow``, ``-m browser``) and overrides the default.
-# The README's command runs the files on every core, a file to a worker (pytest-xdist,
-# ``-n auto --dist loadfile``): a notebook's cells share one kernel, in order, and a module's
-# whole-log runs cached for its tests are made once.
+# Every run spreads the files over the cores, a file to a worker (pytest-xdist, ``-n auto
+# --dist loadfile`` in pyproject's addopts): a notebook's cells share one kernel, in order,
+# and a module's whole-log runs cached for its tests are made once.
 
 SLOW_MODULES = {
     "test_browser.py",  # JupyterLab in headless Chromium
@@ -75,6 +103,7 @@ SLOW_MODULES = {
     "test_graphslam.py",  # every real log with the default SLAM, and its degradations
     "test_invariance.py",  # the default SLAM on worlds moved and turned
     "test_log_sweep.py",  # degraded copies of logs, in parallel
+    "test_parameters.py",  # the default SLAM run once per parameter
     "test_sweep.py",  # seeds x noise levels x methods
     "test_unseen_worlds.py",  # random worlds driven three laps
 }

@@ -6,6 +6,7 @@ import functools
 
 import numpy as np
 import pytest
+from conftest import blind_turn
 
 from fhslam.geometry import wrap_angle
 from fhslam.metrics import ate
@@ -187,34 +188,6 @@ def test_a_corridor_driven_back_the_other_way_is_closed():
     assert ate(r.poses, log.truth).rmse <= 0.03
 
 
-def _blind_turn(log, degrees, before, blind, after):
-    """``log`` (a route driven twice) cut ``after`` metres into its second lap, blind for
-    ``blind`` scans (every range NaN) from ``before`` metres ahead of the first lap's end,
-    while its odometry turns ``degrees`` too far (spread over the blind scans, kept after):
-    the estimate comes back to the start turned and shifted by an amount no scan could
-    correct on the way."""
-    from dataclasses import replace
-
-    from fhslam.geometry import compose, relative
-
-    travelled = np.concatenate([[0.0], np.cumsum(np.hypot(*np.diff(log.truth[:, :2], axis=0).T))])
-    lap = travelled[-1] / 2
-    a = int(np.searchsorted(travelled, lap - before))
-    end = int(np.searchsorted(travelled, lap + after))
-    odometry = log.odometry.copy()
-    for k in range(a, len(odometry)):
-        turn = np.radians(degrees) * min(1.0, (k - a) / blind)
-        odometry[k] = compose(
-            log.odometry[a], compose([0, 0, turn], relative(log.odometry[a], log.odometry[k]))
-        )
-    ranges = log.ranges.copy()
-    ranges[a : a + blind] = np.nan
-    return replace(
-        log, timestamps=log.timestamps[:end], ranges=ranges[:end], odometry=odometry[:end],
-        truth=log.truth[:end], hits=None if log.hits is None else log.hits[:end],
-    )  # fmt: skip
-
-
 def _closure_errors(slam, log):
     """How far (metres) each accepted closure is from the true relative pose."""
     from fhslam.geometry import relative
@@ -236,7 +209,7 @@ def test_a_return_out_of_the_local_searchs_reach_is_closed_globally():
     of the local search (110 m of travel since the last closure), after which the global
     search looks around the estimate too, so that reach is cut to 10 m here
     (``loops.max_radius`` 3 m)."""
-    log = _blind_turn(simulate(load_world("offices"), seed=0, laps=2), 20, 8, 60, 30)
+    log = blind_turn(simulate(load_world("offices"), seed=0, laps=2), 20, 8, 60, 30)
     local = run_slam(
         log,
         "graph",
@@ -259,7 +232,7 @@ def test_a_global_match_that_is_not_unique_is_not_taken(monkeypatch):
     travelled): the best match inside it is one period off (coarse score 0.97). Its runner-up
     more than 1 m away scores 0.92-0.99 of it, so it is refused
     (``GLOBAL_MAX_AMBIGUITY`` 0.8); taken, it closes the lap 10 m off."""
-    log = _blind_turn(simulate(load_world("ring"), seed=0, laps=2), 20, 30, 200, 30)
+    log = blind_turn(simulate(load_world("ring"), seed=0, laps=2), 20, 30, 200, 30)
     wrong = GraphFastHoughSLAM()
     with monkeypatch.context() as m:  # any runner-up allowed
         m.setattr(closure, "GLOBAL_MAX_AMBIGUITY", 1.0)

@@ -53,8 +53,14 @@ def test_every_folder_with_compiled_kernels_is_known_to_the_cache_check():
     written (:func:`fhslam._numba.cache_folder`) must know every such folder."""
     from fhslam._numba import KERNEL_FOLDERS
 
-    folders = {p.parent for p in (ROOT / "fhslam").rglob("*.py") if "@njit" in p.read_text("utf-8")}
-    assert folders and folders <= {f.resolve() for f in KERNEL_FOLDERS}, folders
+    package = Path(fhslam.__file__).resolve().parent  # the installed copy, maybe not ROOT's
+    known = {f.resolve().relative_to(package) for f in KERNEL_FOLDERS}
+    folders = {
+        p.parent.relative_to(package)
+        for p in package.rglob("*.py")
+        if "@njit" in p.read_text("utf-8")
+    }
+    assert folders and folders <= known, folders
 
 
 MAX_MODULE_LINES = 600

@@ -597,7 +597,7 @@ span_summary(res_mit, t1_mit, t2_mit, rel_mit)
 # 39× faster than real time (the table below). This log is where the method was least robust: before
 # closures that move a keyframe far had to wait for an independent one, a relative change of 1e-15
 # in the odometry could decide a few loop closures differently and cost decimetres;
-# `tests/test_graphslam.py` now checks that such last-bit noise leaves it at a few centimetres.
+# `tests/test_real_logs.py` checks that such last-bit noise leaves it at a few centimetres.
 
 # %% tags=["nbval-ignore-output"]
 # wall-clock seconds of the commands of section 2 with mit-csail (/usr/bin/time)

@@ -100,7 +100,8 @@ def blind_turn(log, degrees, before, blind, after):
 SLOW_MODULES = {
     "test_browser.py",  # JupyterLab in headless Chromium
     "test_golden.py",  # whole-log trajectories and maps pinned to the bit
-    "test_graphslam.py",  # every real log with the default SLAM, and its degradations
+    "test_graphslam.py",  # the default SLAM on simulated worlds, whole runs
+    "test_real_logs.py",  # every real log with the default SLAM, and its degradations
     "test_invariance.py",  # the default SLAM on worlds moved and turned
     "test_log_sweep.py",  # degraded copies of logs, in parallel
     "test_parameters.py",  # the default SLAM run once per parameter
@@ -158,7 +159,7 @@ SLOW_TESTS = {  # each over a second or so on 2 cores (pytest --durations)
     "test_no_return.py::test_the_real_logs_keep_their_range_and_code",
     "test_relations.py::test_evaluate_relations_errors_are_one_line",
     "test_results.py::test_the_committed_fht_run_starts_as_a_run_now",
-    "test_results.py::test_the_committed_graph_run_is_the_one_test_graphslam_measures",
+    "test_results.py::test_the_committed_graph_run_is_the_one_test_real_logs_measures",
     "test_rosbag.py::test_fr079_loaded_as_a_dataset_gets_its_original_mount",
     "test_rosbag.py::test_intel_bag_matches_its_relations_and_published_odometry_error",
     "test_sim.py::test_drifting_preset_drift_over_seeds_as_documented",

@@ -172,12 +172,12 @@ def test_the_committed_graph_files_are_one_run(name):
 
 
 @pytest.mark.parametrize("name", LOGS)
-def test_the_committed_graph_run_is_the_one_test_graphslam_measures(name, real_logs):
+def test_the_committed_graph_run_is_the_one_test_real_logs_measures(name, real_logs):
     """The mean translational relations error of the committed run is the one
-    tests/test_graphslam.py's REAL_LOGS states was measured with the default method, to 1 mm
+    tests/test_real_logs.py's REAL_LOGS states was measured with the default method, to 1 mm
     (last-bit noise in the odometry moved mit-csail's by 0.4 mm): when a change of the method
     moves that number, the files are made again."""
-    from test_graphslam import REAL_LOGS
+    from test_real_logs import REAL_LOGS
 
     from fhslam.metrics import relations_error
 

@@ -1,0 +1,212 @@
+"""The default SLAM on the real logs: each log's relation error within its limit, and how
+little range noise, dropped scans and the odometry's last bit move it (the robustness bound);
+the hospital's return after 900 m without a closure."""
+
+from __future__ import annotations
+
+import functools
+
+import numpy as np
+import pytest
+
+from fhslam.geometry import wrap_angle
+from fhslam.pipeline import run_slam
+from fhslam.sim import degrade, perturb_odometry
+
+
+@functools.cache
+def _plain_run(name):
+    """The default SLAM on a shared log as it is: its timestamps and poses (run once per
+    session)."""
+    from fhslam.datasets import load_log
+
+    r = run_slam(load_log(name))
+    return r.timestamps, r.poses
+
+
+def _relations_error(real_data, name, odometry_noise_seed=None, drop_fraction=0.0, range_noise=0.0):
+    from fhslam.datasets import find_dataset, load_log
+    from fhslam.io import read_relations
+    from fhslam.metrics import relations_error
+
+    rel = read_relations(find_dataset(name, "relations"))
+    if odometry_noise_seed is None and not drop_fraction and not range_noise:
+        return relations_error(*_plain_run(name), *rel)
+    log = load_log(name)  # found where the real_data fixture found them
+    if odometry_noise_seed is not None:  # last-bit noise: what another CPU may do
+        log = perturb_odometry(log, odometry_noise_seed)
+    if drop_fraction or range_noise:
+        log = degrade(log, drop_fraction=drop_fraction, range_noise=range_noise, seed=0)
+    r = run_slam(log)  # the default method, the same defaults for every log
+    return relations_error(r.timestamps, r.poses, *rel)
+
+
+def _robustness_bound(every_scan: float) -> float:
+    """The robustness bound: a perturbation may change a log's relation error by at most
+    25 % or 1 cm, whichever is larger."""
+    return max(1.25 * every_scan, every_scan + 0.01)
+
+
+# Mean translational relation error over all relations, metres, with the default method and
+# the same defaults for every log: (the limit, measured on a 2-core machine). The assertion
+# is the limit: the measured values leave room for last-bit differences between CPUs.
+REAL_LOGS = {
+    "intel": (0.05, 0.0140),
+    "aces": (0.06, 0.0343),
+    "mit-csail": (0.06, 0.0267),
+    "fr079": (0.08, 0.0300),
+    "fr-clinic": (0.15, 0.127),
+}
+
+
+@pytest.mark.parametrize("name", REAL_LOGS)
+def test_real_log_relations_error_meets_its_limit(real_data, name):
+    limit, measured = REAL_LOGS[name]
+    e = _relations_error(real_data, name)
+    assert e.n_used == e.n_total
+    assert e.trans_mean <= limit, f"{name}: {e.trans_mean:.4f} m (measured {measured} m)"
+
+
+def test_the_hospitals_relations_under_a_minute_hold(real_data):
+    """The hospital's mean over all relations is decided by its return to the start (closed
+    by the global search, above); its 2,642 relations under a minute measure the local
+    accuracy: 0.0944 m (0.0944 and 0.0983 m with 1 mm range noise or 10 % of the scans
+    dropped; the odometry's 0.0772 m is still better)."""
+    from fhslam.datasets import find_dataset
+    from fhslam.io import read_relations
+    from fhslam.metrics import relations_error
+
+    t1, t2, z = read_relations(find_dataset("fr-clinic", "relations"))
+    short = np.abs(t2 - t1) < 60
+    e = relations_error(*_plain_run("fr-clinic"), t1[short], t2[short], z[short])
+    assert e.n_used == short.sum() == 2642
+    assert e.trans_mean <= 0.105, f"{e.trans_mean:.4f} m"
+
+
+def _clinic_error(params=None, **degraded) -> float:
+    """The hospital's mean translational relation error (metres) of a run of the default
+    SLAM (or ``params``) on the log degraded by ``degraded`` (:func:`fhslam.sim.degrade`)."""
+    from fhslam.datasets import find_dataset, load_log
+    from fhslam.io import read_relations
+    from fhslam.metrics import relations_error
+
+    r = run_slam(degrade(load_log("fr-clinic"), **degraded), params=params)
+    rel = read_relations(find_dataset("fr-clinic", "relations"))
+    return relations_error(r.timestamps, r.poses, *rel).trans_mean
+
+
+@pytest.mark.parametrize(
+    "degraded",
+    [
+        {"range_noise": 0.001, "seed": 0},
+        {"drop_fraction": 0.1, "seed": 0},
+        {"drop_fraction": 0.1, "seed": 3},
+    ],
+    ids=["range-noise", "dropped-scans", "dropped-scans-seed-3"],
+)
+def test_the_hospital_is_robust(real_data, degraded):
+    """The robustness bound: 1 mm of Gaussian noise on every range, or 10 % of the scans
+    dropped, may change the relation error by at most 25 % (or 1 cm). Measured 0.1275 m
+    with the noise, 0.1297 m with the drops and 0.1381 m with the drops of seed 3 (0.1267 m
+    unperturbed). Seed 3's return scores 0.59 where it is found: with a ``search.min_score``
+    of 0.6 it is missed (2.13 m). Without the global search looking where the odometry puts
+    the robot, and from 10 m without a closure on, the noise and the drops give 3.14 m and
+    4.47 m: the return to the start lies 85-146 m and 25-40 degrees off the estimate."""
+    measured = REAL_LOGS["fr-clinic"][1]
+    e = _clinic_error(**degraded)
+    assert e <= _robustness_bound(measured), f"{e:.4f} m"
+
+
+HOSPITAL_CURVED_WALL = (
+    "the tracker turns 13-16 degrees too far over the hospital's scans 2541-2564 (a curved "
+    "wall 3-5 m away, people about), where the odometry agrees with the benchmark's "
+    "relations to 0.01 degrees; scan-to-scan matching without a map does the same (+14 "
+    "degrees): so the return closed at scans 2599-2644 leaves the start out of reach."
+)
+
+
+@pytest.mark.xfail(strict=True, reason=HOSPITAL_CURVED_WALL)
+def test_the_hospitals_curved_wall_turns_as_the_relations_say(real_data):
+    """The known failure behind the hospital's map of scans 2599-2644, on 60 scans (0.5 s):
+    the default SLAM from scan 2520 to 2579, its headings between scans of the benchmark's
+    relations there (relations 35.2, 44.8 and 16.7 degrees; measured 40.8, 54.1 and 23.9).
+    Strict: a change that fixes it must say so."""
+    import dataclasses
+
+    from fhslam.datasets import find_dataset, load_log
+    from fhslam.io import read_relations
+
+    full = load_log("fr-clinic")
+    lo, hi = 2520, 2580
+    cut = {f: getattr(full, f)[lo:hi] for f in ("timestamps", "ranges", "odometry")}
+    log = dataclasses.replace(full, angle_offsets=full.angle_offsets[lo:hi], **cut)
+    r = run_slam(log)
+    t1, t2, z = read_relations(find_dataset("fr-clinic", "relations"))
+    pairs = [(2541, 2551), (2546, 2556), (2551, 2561)]
+    for a, b in pairs:
+        (q,) = np.flatnonzero(
+            (np.abs(t1 - full.timestamps[a]) < 1e-3) & (np.abs(t2 - full.timestamps[b]) < 1e-3)
+        )
+        ours = r.poses[b - lo, 2] - r.poses[a - lo, 2]
+        off = np.degrees(wrap_angle(ours - z[q, 2]))
+        assert abs(off) <= 3.0, f"scans {a}-{b}: {off:+.1f} degrees off the relation"
+
+
+@pytest.mark.parametrize("seed", [1, 2])
+def test_mit_csail_does_not_turn_on_the_last_bit(real_data, seed):
+    """The odometry multiplied by (1 + 1e-15 ε): closures that would move a keyframe far wait
+    for an independent one (without that, seed 2 gave 0.394 m); measured 0.0271, 0.0267 and
+    0.0267 m for seeds 1, 2 and unperturbed."""
+    e = _relations_error(real_data, "mit-csail", odometry_noise_seed=seed)
+    assert e.trans_mean <= 0.035, f"seed {seed}: {e.trans_mean:.4f} m"
+
+
+@pytest.mark.parametrize("name", ["intel", "aces", "mit-csail", "fr079"])
+def test_range_noise_changes_little(real_data, name):
+    """1 mm of Gaussian noise on every range (the robustness bound: no log's error may change
+    by more than 25 % or 1 cm; the hospital: ``test_the_hospital_is_robust``). Measured
+    (degrade seed 0): Intel 0.0141, ACES 0.0343, MIT CSAIL 0.0268, Freiburg 079 0.0301 m;
+    every scan 0.0140, 0.0343, 0.0267, 0.0300 m."""
+    every_scan = REAL_LOGS[name][1]
+    e = _relations_error(real_data, name, range_noise=0.001)
+    assert e.n_used == e.n_total
+    assert e.trans_mean <= _robustness_bound(every_scan), (
+        f"{name}: {e.trans_mean:.4f} m (every scan {every_scan} m)"
+    )
+
+
+@pytest.mark.parametrize(("name", "seed"), [("intel", 1), ("fr079", 2), ("fr-clinic", 1)])
+def test_the_last_bit_changes_little(real_data, name, seed):
+    """The odometry multiplied by (1 + 1e-15 epsilon), what another CPU may do (MIT CSAIL and
+    ACES: their own tests). Measured: Intel 0.0139 m (seed 1), Freiburg 079 0.0302 m (seed
+    2), the hospital 0.1267 m (seeds 1 and 2); every scan 0.0140, 0.0300 and 0.1267 m."""
+    every_scan = REAL_LOGS[name][1]
+    e = _relations_error(real_data, name, odometry_noise_seed=seed)
+    assert e.trans_mean <= max(1.1 * every_scan, every_scan + 0.002), f"{e.trans_mean:.4f} m"
+
+
+@pytest.mark.parametrize("name", ["intel", "aces", "mit-csail", "fr079"])
+def test_dropped_scans_change_little(real_data, name):
+    """10 % of the scans dropped (the robustness bound: no log's error may change by more
+    than 25 % or 1 cm). MIT CSAIL: a 5 Hz laser then turns up to 50 degrees between two
+    scans, into space the local map has not seen; unless the tracker matches such a scan
+    against the previous one, five doubtful scans follow the odometry and force a keyframe
+    14-17 degrees off: 0.73 m (measured 0.0278 m). Freiburg 079: with the bag's laser mount
+    (+0.04 m) the result swings between 0.064 m and 0.040 m (measured 0.0304 m). Intel
+    0.0147 m, ACES 0.0345 m."""
+    every_scan = REAL_LOGS[name][1]
+    e = _relations_error(real_data, name, drop_fraction=0.1)
+    assert e.n_used < e.n_total  # relations at dropped scans cannot be evaluated
+    assert e.trans_mean <= _robustness_bound(every_scan), (
+        f"{name}: {e.trans_mean:.4f} m (every scan {every_scan} m)"
+    )
+
+
+@pytest.mark.parametrize("seed", [None, 1])
+def test_aces_revisit_is_closed_whatever_the_last_bit(real_data, seed):
+    """ACES's revisit (scans 158-172 against 4194-4422): with a Cauchy scale of 1 the
+    closures there lost most of their pull and the two visits stayed 1.1-1.3 m apart unless
+    the last bit happened to help (0.0465 m unperturbed, 0.0345 m with seed 1); measured
+    0.0343 m unperturbed, 0.0345 m with seed 1 (at the default 3)."""
+    e = _relations_error(real_data, "aces", odometry_noise_seed=seed)
+    assert e.trans_mean <= 0.040, f"seed {seed}: {e.trans_mean:.4f} m"

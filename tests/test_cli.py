@@ -949,11 +949,10 @@ def test_slam_set_reaches_the_trackers_parameters(short_clf, tmp_path):
             "foo=1",
             "'foo' is not a number or switch of GraphSlamParams or of its groups (",
         ),
-        ("lines.extraction.foo=1", "'lines.extraction.foo' is not a number or switch"),
+        ("lines.extraction.cluster_gap=1", "'lines.extraction.cluster_gap' is not a number or"),
         ("tracker=1", "'tracker' is not a number or switch"),
         ("odometry_sigma=0.1", "'odometry_sigma' is not a number or switch"),
         ("loops.target_keyframes=1.5", "loops.target_keyframes takes an integer, got '1.5'"),
-        ("lines.extraction.drop_lone_points=maybe", "drop_lone_points takes true or false"),
         ("loops.min_score=nan", "loops.min_score takes a finite number, got 'nan'"),
         ("loops.min_score=1.5", "'loops.min_score=1.5': LoopParams.min_score must be in"),
         ("loops.target_keyframes=-1", "target_keyframes must be >= 0 and at most 1000"),
@@ -974,41 +973,60 @@ def test_slam_bad_set_is_named_and_writes_nothing(short_clf, tmp_path, setting, 
 
 
 def test_set_reaches_every_group_of_the_parameters():
-    """``--set GROUP.NAME=VALUE`` reaches a number or switch of any group of
-    ``GraphSlamParams``, at any depth, by ``dataclasses.replace`` on the defaults; an
-    optional number also takes ``none``; the error names the groups and every settable name,
-    and a value out of range names the ``--set`` that gave it."""
+    """``--set GROUP.NAME=VALUE`` reaches a number or switch of any group of a method's
+    parameters (``GraphSlamParams``, the paper's ``SlamParams``), at any depth, by
+    ``dataclasses.replace`` on the defaults; an optional number also takes ``none``; the
+    error names the groups and every settable name, and a value out of range names the
+    ``--set`` that gave it."""
     from dataclasses import replace
 
-    from fhslam.cli.common import graph_params
+    from fhslam.cli.common import method_params
     from fhslam.errors import InputError
-    from fhslam.slam import GraphSlamParams
+    from fhslam.slam import GraphSlamParams, SlamParams
 
-    params = graph_params(
-        ["lines.extraction.cluster_gap=0.3", "tracker.window = 0.3", "lines.robust_scale=none"]
-    )
+    params = method_params("graph", ["loops.min_score=0.6", "tracker.window = 0.3"])
     default = GraphSlamParams()
-    assert params.lines.extraction.cluster_gap == 0.3 and params.tracker.window == 0.3
-    assert params.lines.robust_scale is None
-    assert params.lines.matching == default.lines.matching
+    assert params.loops.min_score == 0.6 and params.tracker.window == 0.3
     assert replace(params.tracker, window=default.tracker.window) == default.tracker
+    assert replace(params.loops, min_score=default.loops.min_score) == default.loops
+    assert params.keyframes == default.keyframes and params.search == default.search
+    paper = method_params("fht", ["extraction.cluster_gap=0.3", "robust_scale=none",
+                                  "extraction.drop_lone_points=off"])  # fmt: skip
+    assert paper.extraction.cluster_gap == 0.3 and paper.robust_scale is None
+    assert paper.extraction.drop_lone_points is not SlamParams().extraction.drop_lone_points
+    assert paper.matching == SlamParams().matching
     with pytest.raises(InputError) as e:
-        graph_params(["foo=1"])
-    for part in ("tracker.NAME: TrackerParams", "lines.extraction.NAME: ExtractionParams"):
+        method_params("graph", ["foo=1"])
+    for part in ("tracker.NAME: TrackerParams", "loops.NAME: LoopParams"):
         assert part in str(e.value)
-    assert "lines.extraction.cluster_gap, " in str(e.value).partition("; one of: ")[2]
-    with pytest.raises(InputError, match=r"^--set 'lines\.extraction\.densify_step=1e-9': Ext"):
-        graph_params(["tracker.window=0.3", "lines.extraction.densify_step=1e-9"])
-    with pytest.raises(InputError, match=r"lines\.robust_scale takes a finite number or none"):
-        graph_params(["lines.robust_scale=x"])
+    assert "loops.min_score, " in str(e.value).partition("; one of: ")[2]
+    with pytest.raises(InputError, match=r"^--set 'extraction\.densify_step=1e-9': Extrac"):
+        method_params("fht", ["matching.max_distance=0.3", "extraction.densify_step=1e-9"])
+    with pytest.raises(InputError, match=r"robust_scale takes a finite number or none, got 'x'"):
+        method_params("classical", ["robust_scale=x"])
+    with pytest.raises(InputError, match="drop_lone_points takes true or false, got 'maybe'"):
+        method_params("fht", ["extraction.drop_lone_points=maybe"])
+    with pytest.raises(InputError, match=r"^--set: the odometry method takes no parameters$"):
+        method_params("odometry", ["x=1"])
 
 
-def test_slam_set_is_refused_for_other_methods(short_clf, tmp_path):
-    r = run("slam", str(short_clf), "--method", "fht", "--trajectory", str(tmp_path / "t.txt"),
-            "--set", "loops.min_score=0.6")  # fmt: skip
+def test_slam_set_reaches_the_papers_method(short_clf, tmp_path):
+    """``--method fht --set`` sets the paper's parameters: the run differs from the
+    default's, and the trajectory's header records the setting."""
+    out = [tmp_path / "a.txt", tmp_path / "b.txt"]
+    for path, sets in zip(out, ([], ["--set", "extraction.cluster_gap=0.05"]), strict=True):
+        r = run("slam", str(short_clf), "--method", "fht", "--trajectory", str(path), *sets)
+        assert r.returncode == 0, r.stderr
+    a, b = (np.loadtxt(p)[:, 1:] for p in out)
+    assert a.shape == b.shape and np.abs(a - b).max() > 1e-6
+    assert "--method fht --set extraction.cluster_gap=0.05 " in out[1].read_text()
+
+
+def test_slam_set_is_refused_for_a_method_without_parameters(short_clf, tmp_path):
+    r = run("slam", str(short_clf), "--method", "odometry", "--trajectory",
+            str(tmp_path / "t.txt"), "--set", "loops.min_score=0.6")  # fmt: skip
     assert r.returncode == 2 and r.stderr == (
-        "fhslam: error: --set: only with --method graph; set the fht method's parameters in "
-        "Python (nothing was written)\n"
+        "fhslam: error: --set: the odometry method takes no parameters\n"
     )
     assert list(tmp_path.iterdir()) == []
 

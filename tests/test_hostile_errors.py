@@ -188,10 +188,18 @@ def test_the_ends_of_a_range_are_taken(cls, name):
         assert getattr(cls(**{name: value}), name) == value
 
 
+def test_the_graph_method_refuses_parameters_of_another_class():
+    from fhslam.slam import GraphFastHoughSLAM
+
+    with pytest.raises(TypeError, match=r"^GraphFastHoughSLAM: lines must be a SlamParams, got M"):
+        GraphFastHoughSLAM(lines=MatchParams())
+    with pytest.raises(TypeError, match=r"params must be a GraphSlamParams, got SlamParams$"):
+        GraphFastHoughSLAM(SlamParams())
+
+
 def test_nested_parameters_must_be_of_their_class():
     for make, message in (
         (lambda: GraphSlamParams(tracker={"window": 0.3}), "GraphSlamParams.tracker must be"),
-        (lambda: GraphSlamParams(lines=None), "GraphSlamParams.lines must be a SlamParams"),
         (lambda: SlamParams(matching=3), "SlamParams.matching must be a MatchParams"),
         (lambda: SlamParams(extractor=5), "SlamParams.extractor must be callable"),
         (lambda: ExtractionParams(densify_step=1e-9), "densify_step must be 0 (off) or"),

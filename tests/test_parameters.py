@@ -114,13 +114,12 @@ def test_every_parameter_is_moved_once():
     names = {
         f"{g.name}.{f.name}"
         for g in dataclasses.fields(GraphSlamParams)
-        if g.name != "lines"
         for f in dataclasses.fields(
             g.type if isinstance(g.type, type) else type(getattr(BASE, g.name))
         )
     }
     assert set(MOVED) | set(ELSEWHERE) == names and not set(MOVED) & set(ELSEWHERE)
-    assert len(names) == count_parameters(BASE, skip=("lines",))
+    assert len(names) == count_parameters(BASE)
 
 
 @pytest.mark.parametrize("setting", sorted(MOVED))

@@ -1,5 +1,5 @@
 """What several commands share: argument types and options, reading a log, pictures,
-``--profile``, the SLAM methods' names and the graph method's ``--set NAME=VALUE``.
+``--profile``, the SLAM methods' names and a method's ``--set NAME=VALUE``.
 
 Nothing heavy is imported here at module level: the parser is built, and ``--help``
 answered, without NumPy, numba or matplotlib.
@@ -252,7 +252,7 @@ def profiling(enabled: bool) -> Iterator[None]:
 
 
 # --------------------------------------------------------------------------------------------
-# --set NAME=VALUE: the graph method's parameters
+# --set NAME=VALUE: a method's parameters
 
 _KINDS = (bool, int, float)
 """The types of a field that ``--set`` sets: switches and numbers."""
@@ -340,30 +340,34 @@ def _replaced(params, prefix: str, values: dict[str, object]):
     return dataclasses.replace(params, **changes) if changes else params
 
 
-def graph_params(pairs: list[str]):
-    """The :class:`~fhslam.slam.GraphSlamParams` of ``--set NAME=VALUE`` options: the
+def method_params(method: str, pairs: list[str]):
+    """The parameters of SLAM method ``method`` (its :attr:`fhslam.pipeline.Method.params_type`,
+    e.g. :class:`~fhslam.slam.GraphSlamParams`) of ``--set NAME=VALUE`` options: the
     defaults, with each named number or switch (a field of type bool, int or float, or one
     of those or None) set; ``GROUP.NAME`` names one of a group's, a field that is itself a
-    dataclass of parameters (``tracker.window``, ``lines.extraction.cluster_gap``)."""
+    dataclass of parameters (``loops.min_score``, ``extraction.cluster_gap``)."""
     from fhslam.errors import InputError, ParameterError
-    from fhslam.slam import GraphSlamParams
+    from fhslam.pipeline import METHODS
 
+    cls = METHODS[method].params_type
+    if cls is None:
+        raise InputError(f"--set: the {method} method takes no parameters")
     groups: dict[str, type] = {}
-    kinds = _settable(GraphSlamParams, groups=groups)
+    kinds = _settable(cls, groups=groups)
     values: dict[str, object] = {}
     for pair in pairs:
         name, sep, text = (x.strip() for x in pair.partition("="))
         if not sep or not name or not text:
-            raise InputError(f"--set {pair!r}: expected NAME=VALUE, e.g. loops.target_keyframes=4")
+            raise InputError(f"--set {pair!r}: expected NAME=VALUE or GROUP.NAME=VALUE")
         if name not in kinds:
             named = ", ".join(f"{p}NAME: {c.__name__}" for p, c in groups.items() if p)
             raise InputError(
-                f"--set {pair!r}: {name!r} is not a number or switch of GraphSlamParams or of "
+                f"--set {pair!r}: {name!r} is not a number or switch of {cls.__name__} or of "
                 f"its groups ({named}); one of: {', '.join(sorted(kinds))}"
             )
         values[name] = _parse_value(pair, name, text, *kinds[name])
     try:
-        return _replaced(GraphSlamParams(), "", values)
+        return _replaced(cls(), "", values)
     except ParameterError as e:  # out of its range: name the --set that gave it
         keys = [p + e.name for p, c in groups.items() if c.__name__ == e.owner] or [e.name]
         given = [p for p in pairs if p.partition("=")[0].strip() in keys]

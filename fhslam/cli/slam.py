@@ -12,8 +12,8 @@ from pathlib import Path
 from fhslam.cli.common import (
     add_method_argument,
     degrade_arguments,
-    graph_params,
     log_arguments,
+    method_params,
     plot_format,
     random_seed,
     read_log,
@@ -59,9 +59,11 @@ def add_parser(sub) -> argparse.ArgumentParser:
         action="append",
         default=[],
         metavar="NAME=VALUE",
-        help="--method graph: set a parameter of fhslam.slam.GraphSlamParams as GROUP.NAME "
-        "(groups: keyframes, tracker, edges, loops, search, optimiser, lines; repeat for more), "
-        "e.g. --set loops.min_score=0.6 --set search.every=0; the trajectory's header records it",
+        help="set a parameter of the method (graph: fhslam.slam.GraphSlamParams, groups keyframes, "
+        "tracker, edges, loops, search, optimiser; fht and classical: fhslam.slam.SlamParams; "
+        "ekf: fhslam.slam.EKFParams) as NAME or GROUP.NAME (repeat for more), e.g. --set "
+        "loops.min_score=0.6, or --method fht --set extraction.cluster_gap=0.3; the trajectory's "
+        "header records it",
     )
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     g = p.add_argument_group(
@@ -128,8 +130,8 @@ def run(args: argparse.Namespace) -> None:
 
 
 def _checked_params(args: argparse.Namespace):
-    """The graph method's parameters of ``--set`` (``None`` without any); refuses
-    ``--graph`` and ``--set`` with another method."""
+    """The method's parameters of ``--set`` (``None`` without any); refuses ``--graph``
+    with another method than the graph."""
     from fhslam.errors import InputError
 
     if args.graph is not None and args.method != "graph":
@@ -137,12 +139,7 @@ def _checked_params(args: argparse.Namespace):
             f"--graph: only with --method graph; the {args.method} method keeps no keyframe "
             "graph (nothing was written)"
         )
-    if args.set and args.method != "graph":
-        raise InputError(
-            f"--set: only with --method graph; set the {args.method} method's parameters in "
-            "Python (nothing was written)"
-        )
-    return graph_params(args.set) if args.set else None
+    return method_params(args.method, args.set) if args.set else None
 
 
 def _write_outputs(args: argparse.Namespace, log, result, graph, degraded: str) -> list[str]:

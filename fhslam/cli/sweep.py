@@ -12,7 +12,7 @@ from fhslam.cli.common import (
     METHOD_NAMES,
     add_method_argument,
     degrade_arguments,
-    graph_params,
+    method_params,
     plot_format,
     random_seed,
     save_figure,
@@ -131,7 +131,7 @@ def run(args: argparse.Namespace) -> None:
     methods = args.methods or (["graph"] if args.log is not None else list(METHOD_NAMES))
     if args.set and "graph" not in methods:
         raise InputError("--set: only with the graph method among --methods")
-    params = graph_params(args.set) if args.set else None
+    params = method_params("graph", args.set) if args.set else None
     if args.log is not None:
         _log_sweep(args, methods, params)
         return

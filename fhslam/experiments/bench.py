@@ -282,14 +282,13 @@ pose arithmetic and the driver. ``fht`` and ``classical`` (:class:`fhslam.slam.F
 def instrumented_backend(method: str, timer: StageTimer):
     """A fresh back end for ``method`` with its stages (:data:`STAGES`) timed by ``timer``."""
     from fhslam.pipeline import make_backend
-    from fhslam.slam import GraphSlamParams
+    from fhslam.slam import GraphFastHoughSLAM, SlamParams
 
     if method == "graph":
-        params = GraphSlamParams()
-        lines = params.lines
-        loop1 = lines.extractor or functools.partial(extract_lines, params=lines.extraction)
-        lines = replace(lines, extractor=timer.wrap(loop1, "extraction"))
-        backend = make_backend("graph", replace(params, lines=lines))
+        paper = SlamParams()
+        loop1 = functools.partial(extract_lines, params=paper.extraction)
+        lines = replace(paper, extractor=timer.wrap(loop1, "extraction"))
+        backend = GraphFastHoughSLAM(lines=lines)
         timer.patch(backend.tracker, "track", "tracking")
         timer.patch(backend, "_update_local_map", "local map")
         timer.patch(backend, "_close_loops", "loop closure")

@@ -21,7 +21,6 @@ from dataclasses import dataclass, field, fields, is_dataclass
 from typing import ClassVar
 
 from fhslam.errors import ParameterError, Range, Ranged
-from fhslam.slam.fht import SlamParams
 from fhslam.slam.graph.tracker import TrackerParams
 
 __all__ = [
@@ -239,9 +238,10 @@ class GraphSlamParams:
         The global search after a long stretch without a closure.
     optimiser : OptimiserParams
         The pose graph's Gauss-Newton rounds.
-    lines : SlamParams
-        The paper's Loops 1 and 2 (the ``fht`` method's parameters): each keyframe's line
-        extraction, and the matching and merging of the map of reference lines.
+
+    These are all the parameters of the estimate. The map of fast Hough lines drawn from the
+    keyframes takes the paper's own (the ``fht`` method's :class:`~fhslam.slam.SlamParams`,
+    :class:`~fhslam.slam.GraphFastHoughSLAM`'s ``lines``): they move no pose.
     """
 
     keyframes: KeyframeParams = field(default_factory=KeyframeParams)
@@ -250,7 +250,6 @@ class GraphSlamParams:
     loops: LoopParams = field(default_factory=LoopParams)
     search: GlobalSearchParams = field(default_factory=GlobalSearchParams)
     optimiser: OptimiserParams = field(default_factory=OptimiserParams)
-    lines: SlamParams = field(default_factory=SlamParams)
 
     def __post_init__(self) -> None:
         for f in fields(self):
@@ -261,14 +260,11 @@ class GraphSlamParams:
                 )
 
 
-def count_parameters(params: object, skip: tuple[str, ...] = ()) -> int:
-    """The number of leaf fields of a dataclass of parameters, its groups opened (fields
-    named in ``skip`` left out): ``count_parameters(GraphSlamParams(), skip=("lines",))`` is
-    the default method's own parameters."""
+def count_parameters(params: object) -> int:
+    """The number of leaf fields of a dataclass of parameters, its groups opened:
+    ``count_parameters(GraphSlamParams())`` is the default method's parameters."""
     n = 0
     for f in fields(params):
-        if f.name in skip:
-            continue
         value = getattr(params, f.name)
         n += count_parameters(value) if is_dataclass(value) else 1
     return n

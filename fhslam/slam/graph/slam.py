@@ -19,6 +19,7 @@ from fhslam.reference_map import ReferenceMap
 from fhslam.scan import Scan
 from fhslam.scanmatch import Refinement, densify, scan_normals, smooth_scan, voxel_index
 from fhslam.slam.base import FinalEstimate, StepResult
+from fhslam.slam.fht import SlamParams
 from fhslam.slam.graph.closure import HeldClosure, LoopClosing, LoopClosure
 from fhslam.slam.graph.params import GraphSlamParams
 from fhslam.slam.graph.search import GlobalSearch
@@ -62,12 +63,17 @@ class GraphFastHoughSLAM(LoopClosing, GlobalSearch):
     Parameters
     ----------
     params : GraphSlamParams, optional
+        The parameters of the estimate (default: the defaults).
     initial_pose : array-like, shape (3,), optional
         The pose of the first scan; default: the first odometry pose.
     background : bool
         Run the back end (the pose graph, loop closures, optimisation) on a thread of its
         own while the front end tracks the next scans (see :class:`InOrder`): the same
         results, bit for bit, as ``False``, which runs it in turn.
+    lines : SlamParams, optional
+        The paper's Loops 1 and 2 (the ``fht`` method's parameters, default its defaults):
+        each keyframe's fast Hough extraction, and the matching and merging of the map of
+        reference lines (:meth:`build_map`). They shape the map only, never a pose.
     """
 
     def __init__(
@@ -75,8 +81,15 @@ class GraphFastHoughSLAM(LoopClosing, GlobalSearch):
         params: GraphSlamParams | None = None,
         initial_pose: ArrayLike | None = None,
         background: bool = True,
+        lines: SlamParams | None = None,
     ):
         self.params = params or GraphSlamParams()
+        self.lines = lines or SlamParams()
+        if not isinstance(self.params, GraphSlamParams) or not isinstance(self.lines, SlamParams):
+            bad = "params" if not isinstance(self.params, GraphSlamParams) else "lines"
+            want = "GraphSlamParams" if bad == "params" else "SlamParams"
+            got = type(getattr(self, bad)).__name__
+            raise TypeError(f"GraphFastHoughSLAM: {bad} must be a {want}, got {got}")
         self.tracker = ScanTracker(self.params.tracker)
         self._graph = PoseGraph()
         self._loops: list[LoopClosure] = []
@@ -151,7 +164,7 @@ class GraphFastHoughSLAM(LoopClosing, GlobalSearch):
         )
         if new:
             if scan is not None:
-                fe = p.lines
+                fe = self.lines
                 all_points = scan.points()[0]
                 lines = (
                     fe.extractor(all_points)
@@ -357,7 +370,7 @@ class GraphFastHoughSLAM(LoopClosing, GlobalSearch):
         """The map of reference lines from the keyframes' lines at their optimised poses
         (:meth:`fhslam.reference_map.ReferenceMap.update`: the front end's policy, applied
         keyframe by keyframe)."""
-        fe = self.params.lines
+        fe = self.lines
         if self.origin is None:
             return []
         self.sync()

@@ -1,7 +1,7 @@
 """Golden numbers: trajectories, maps, extracted lines and figures pinned across refactors.
 
-``tests/golden/golden.npz`` was recorded by ``tests/golden/make_golden.py`` before the
-issue-9 move of the house (commit message says which). Every case is recomputed here through
+``tests/golden/golden.npz`` was recorded by ``tests/golden/make_golden.py`` (its commit
+message says on which code). Every case is recomputed here through
 the package's calls and compared:
 
 - on a machine whose floating-point primitives give the recording's bits (the *arithmetic

@@ -141,13 +141,13 @@ class SlamBenchRow:
 def run_slam_bench(world: str = "paper", seed: int = 0, repeats: int = 3) -> list[SlamBenchRow]:
     """SLAM steps per second of FH-SLAM, FH-SLAM on a pose graph, FH-SLAM with the classical
     Hough extractor and the EKF baseline on one simulated run (median wall time over
-    ``repeats`` runs, one process)."""
+    ``repeats`` runs, one process, after a warm-up run over its first scans)."""
     from fhslam.pipeline import run_slam
 
     log = simulate(load_world(world), seed=seed)
     rows = []
     for method in ("fht", "graph", "classical", "ekf"):
-        run_slam(log, method)  # warm-up (JIT, caches)
+        run_slam(log_head(log, 20), method)  # warm-up (JIT, caches)
         t = _median_time(lambda m=method: run_slam(log, m), repeats)
         rows.append(SlamBenchRow(method, len(log) / t, t, len(log)))
     return rows

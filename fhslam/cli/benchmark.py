@@ -6,6 +6,8 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
+from fhslam.cli.common import SCHEDULER_HELP, on_cluster
+
 NAME = "benchmark"
 OUTPUTS = ("--out",)
 """The output options named after Ctrl-C."""
@@ -38,6 +40,7 @@ def add_parser(sub) -> argparse.ArgumentParser:
     )
     p.add_argument("--no-draws", action="store_true", help="no runs over draws")
     p.add_argument("--jobs", type=int, default=-1, help="worker processes for the draws")
+    p.add_argument("--scheduler", metavar="ADDRESS", help=SCHEDULER_HELP + " (the draws)")
     p.add_argument("--quiet", action="store_true", help="no progress bars")
     p.set_defaults(run=run)
     return p
@@ -48,13 +51,14 @@ def run(args: argparse.Namespace) -> None:
     from fhslam.experiments.benchmark import results_table, run_benchmark
 
     kwargs = {"draws": None} if args.no_draws else {}
-    rows = run_benchmark(
-        args.out,
-        logs=args.logs,
-        quick=args.quick,
-        n_jobs=args.jobs,
-        progress=not args.quiet,
-        **kwargs,
-    )
+    with on_cluster(args.scheduler):
+        rows = run_benchmark(
+            args.out,
+            logs=args.logs,
+            quick=args.quick,
+            n_jobs=args.jobs,
+            progress=not args.quiet,
+            **kwargs,
+        )
     print(results_table(rows))
     print(f"wrote {args.out}")

@@ -374,3 +374,25 @@ def method_params(method: str, pairs: list[str]):
         raise InputError(f"--set {given[-1] if given else keys[0]!r}: {e}") from None
     except ValueError as e:
         raise InputError(f"--set: {e}") from None
+
+
+# --------------------------------------------------------------------------------------------
+# --scheduler ADDRESS: the parallel runs on a Dask cluster
+
+SCHEDULER_HELP = (
+    "run the parallel runs on the Dask cluster whose scheduler is at ADDRESS (e.g. "
+    "tcp://10.0.0.5:8786; its workers need fhslam installed; pip install 'fhslam[cluster]') "
+    "instead of this machine's cores"
+)
+
+
+def on_cluster(scheduler: str | None):
+    """A context in which joblib's runs go to the Dask scheduler at ``scheduler``
+    (:func:`fhslam.experiments.cluster.dask_cluster`), or stay on this machine (``None``)."""
+    import contextlib
+
+    if scheduler is None:
+        return contextlib.nullcontext()
+    from fhslam.experiments.cluster import dask_cluster
+
+    return dask_cluster(scheduler)

@@ -10,9 +10,11 @@ from pathlib import Path
 
 from fhslam.cli.common import (
     METHOD_NAMES,
+    SCHEDULER_HELP,
     add_method_argument,
     degrade_arguments,
     method_params,
+    on_cluster,
     plot_format,
     random_seed,
     save_figure,
@@ -79,6 +81,7 @@ def add_parser(sub) -> argparse.ArgumentParser:
         "them in its settings column",
     )
     p.add_argument("--jobs", type=int, default=-1, help="worker processes (default: all cores)")
+    p.add_argument("--scheduler", metavar="ADDRESS", help=SCHEDULER_HELP)
     p.add_argument("--out", type=Path, help="write every run to this CSV file")
     p.add_argument(
         "--plot",
@@ -146,7 +149,20 @@ def run(args: argparse.Namespace) -> None:
     # and an output that cannot be written (a directory, no such folder, a read-only one),
     # before the hours of work
     check_outputs({"--out": args.out}, {"the world file": None if builtin else world_name})
-    rows = compare.slam_sweep(
+    with on_cluster(args.scheduler):
+        rows = _world_sweep(args, world_name, methods, params)
+    if args.out is not None:
+        compare.save_sweep(rows, args.out)
+    if args.set:  # not in the file: its columns are fixed (notebook 07 reads it)
+        print("the graph method with " + " ".join(f"--set {x}" for x in args.set))
+    print(compare.format_summary(rows))
+
+
+def _world_sweep(args: argparse.Namespace, world_name: str, methods: list[str], params):
+    """:func:`fhslam.experiments.compare.slam_sweep` with the options of ``args``."""
+    from fhslam.experiments import compare
+
+    return compare.slam_sweep(
         world=world_name,
         seeds=range(args.seeds),
         levels=args.levels or ["low", "medium", "high"],
@@ -160,11 +176,6 @@ def run(args: argparse.Namespace) -> None:
         last_bit_draws=args.last_bit_draws,
         params=params,
     )
-    if args.out is not None:
-        compare.save_sweep(rows, args.out)
-    if args.set:  # not in the file: its columns are fixed (notebook 07 reads it)
-        print("the graph method with " + " ".join(f"--set {x}" for x in args.set))
-    print(compare.format_summary(rows))
 
 
 def _log_sweep(args: argparse.Namespace, methods: list[str], params) -> None:
@@ -191,19 +202,20 @@ def _log_sweep(args: argparse.Namespace, methods: list[str], params) -> None:
         {"--out": args.out, "--plot": args.plot}, {"--log": args.log, "--relations": args.relations}
     )
     plot_format(args.plot)
-    rows = robustness.log_sweep(
-        args.log,
-        args.relations,
-        seeds=range(args.seeds),
-        range_noise=args.range_noise,
-        drop_fraction=args.drop_scans,
-        clutter_fraction=args.clutter,
-        last_bit_draws=args.last_bit_draws,
-        methods=methods,
-        params=params,
-        n_jobs=args.jobs,
-        progress=not args.quiet,
-    )
+    with on_cluster(args.scheduler):
+        rows = robustness.log_sweep(
+            args.log,
+            args.relations,
+            seeds=range(args.seeds),
+            range_noise=args.range_noise,
+            drop_fraction=args.drop_scans,
+            clutter_fraction=args.clutter,
+            last_bit_draws=args.last_bit_draws,
+            methods=methods,
+            params=params,
+            n_jobs=args.jobs,
+            progress=not args.quiet,
+        )
     if args.out is not None:
         robustness.save_log_sweep(rows, args.out)
     print(robustness.format_log_sweep(rows))

@@ -134,8 +134,7 @@ def optimize(
         w = np.ones(ne)
         m = c > 0
         if m.any():
-            phi = c[m] ** 2  # dynamic covariance scaling (Agarwal et al. 2013), Φ = c²
-            w[m] = np.minimum(1.0, 2.0 * phi / (phi + _chi2(e[m], om[m]))) ** 2
+            w[m] = 1.0 / (1.0 + _chi2(e[m], om[m]) / c[m] ** 2)
         o = om * w[:, None, None]
         jit_o = ji.transpose(0, 2, 1) @ o
         jjt_o = jj.transpose(0, 2, 1) @ o

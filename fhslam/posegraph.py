@@ -276,32 +276,16 @@ class PoseGraph:
         )
 
     def optimize(self, iterations: int = 10, tol: float = 1e-6) -> None:
-        """Optimise all poses in place (node 0 fixed), with the active edges: GTSAM's
-        graduated non-convexity (truncated least squares) over the robust edges, the others
-        known inliers; an edge is an inlier while its squared Mahalanobis error is under 25."""
-        import gtsam
-
-        graph = gtsam.NonlinearFactorGraph()
-        values = gtsam.Values()
-        for k, p in enumerate(self._poses):
-            values.insert(k, gtsam.Pose2(*p))
-        graph.add(gtsam.PriorFactorPose2(0, gtsam.Pose2(*self._poses[0]),
-                                         gtsam.noiseModel.Isotropic.Sigma(3, 1e-6)))
-        inliers = [0]
-        for e, on in enumerate(self._active):
-            if not on:
-                continue
-            info = self._info[e] + np.eye(3) * 1e-9
-            model = gtsam.noiseModel.Gaussian.Information(info)
-            if self._robust[e] == 0:
-                inliers.append(graph.size())
-            graph.add(gtsam.BetweenFactorPose2(self._i[e], self._j[e], gtsam.Pose2(*self._z[e]), model))
-        params = gtsam.GncLMParams()
-        params.setLossType(gtsam.GncLossType.TLS)
-        params.setKnownInliers(inliers)
-        opt = gtsam.GncLMOptimizer(graph, values, params)
-        opt.setInlierCostThresholds(0.5 * 25.0)
-        result = opt.optimize()
-        for k in range(len(self._poses)):
-            q = result.atPose2(k)
-            self._poses[k] = np.array([q.x(), q.y(), q.theta()])
+        """Optimise all poses in place (node 0 fixed), with the active edges."""
+        a = np.array(self._active, dtype=bool)
+        x = optimize(
+            self.poses,
+            np.array(self._i, dtype=np.intp)[a],
+            np.array(self._j, dtype=np.intp)[a],
+            np.array(self._z).reshape(-1, 3)[a],
+            np.array(self._info).reshape(-1, 3, 3)[a],
+            np.array(self._robust)[a],
+            iterations,
+            tol,
+        )
+        self._poses = list(x)

@@ -323,9 +323,17 @@ class GraphFastHoughSLAM(LoopClosing, GlobalSearch):
         return compose(poses[: i + 1], self._views[: i + 1])[:, :2]
 
     def _optimize(self) -> None:
-        """Optimise (the estimator weighs the loop edges)."""
+        """Optimise; switch off loop edges that stay inconsistent, optimise again."""
         p = self.params
         self._graph.optimize(p.optimiser.iterations, p.optimiser.tol)
+        active = [lc for lc in self._loops if self._graph.is_active(lc.edge)]
+        if active:
+            chi2 = self._graph.chi2(np.array([lc.edge for lc in active]))
+            bad = [lc for lc, c in zip(active, chi2, strict=True) if c > p.loops.max_chi2]
+            if bad:
+                for lc in bad:
+                    self._graph.set_active(lc.edge, False)
+                self._graph.optimize(p.optimiser.iterations, p.optimiser.tol)
         self.loop_targets.drop_moved(self._graph.poses)
 
     # -- results ---------------------------------------------------------------------------

@@ -85,11 +85,12 @@ class GraphFastHoughSLAM(LoopClosing, GlobalSearch):
     ):
         self.params = params or GraphSlamParams()
         self.lines = lines or SlamParams()
-        if not isinstance(self.params, GraphSlamParams) or not isinstance(self.lines, SlamParams):
-            bad = "params" if not isinstance(self.params, GraphSlamParams) else "lines"
-            want = "GraphSlamParams" if bad == "params" else "SlamParams"
-            got = type(getattr(self, bad)).__name__
-            raise TypeError(f"GraphFastHoughSLAM: {bad} must be a {want}, got {got}")
+        for name, kind in (("params", GraphSlamParams), ("lines", SlamParams)):
+            if not isinstance(value := getattr(self, name), kind):
+                raise TypeError(
+                    f"GraphFastHoughSLAM: {name} must be a {kind.__name__}, "
+                    f"got {type(value).__name__}"
+                )
         self.tracker = ScanTracker(self.params.tracker)
         self._graph = PoseGraph()
         self._loops: list[LoopClosure] = []
@@ -164,12 +165,11 @@ class GraphFastHoughSLAM(LoopClosing, GlobalSearch):
         )
         if new:
             if scan is not None:
-                fe = self.lines
                 all_points = scan.points()[0]
                 lines = (
-                    fe.extractor(all_points)
-                    if fe.extractor
-                    else extract_lines(all_points, fe.extraction)
+                    self.lines.extractor(all_points)
+                    if self.lines.extractor
+                    else extract_lines(all_points, self.lines.extraction)
                 )
             self._new_keyframe(pose, lines, track, odometry)
         k = len(self._kf_front) - 1

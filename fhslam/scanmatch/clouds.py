@@ -18,6 +18,7 @@ from fhslam._numba import njit
 from fhslam.geometry import as_points, tls_normal_angle
 
 __all__ = [
+    "VOXEL_PHASE",
     "densify",
     "scan_normals",
     "smooth_scan",
@@ -26,14 +27,23 @@ __all__ = [
 ]
 
 
+VOXEL_PHASE = (3 - 5**0.5) / 2
+"""The cells' corners lie this fraction of a cell (0.382) off the frame's axes and round
+coordinates: a point on an axis (a laser's beam straight ahead, ``y = 0`` in its frame) or at
+a quantised range (whole centimetres or millimetres) sits at least a third of a millimetre
+inside a cell of 1-5 cm, not on a border where the last bit of its pose picks the cell."""
+
+
 def voxel_downsample(points: ArrayLike, size: float) -> NDArray[np.float64]:
-    """Keep the first point of each ``size`` × ``size`` cell (order preserved)."""
+    """Keep the first point of each ``size`` × ``size`` cell (order preserved; the cells'
+    corners at ``(k + VOXEL_PHASE) · size``)."""
     p = np.asarray(points, dtype=float).reshape(-1, 2)
     return p[voxel_index(p, size)]
 
 
 def voxel_index(points: ArrayLike, size: float) -> NDArray[np.intp]:
-    """Indices of the first point of each ``size`` × ``size`` cell, increasing.
+    """Indices of the first point of each ``size`` × ``size`` cell (corners at
+    ``(k + VOXEL_PHASE) · size``), increasing.
 
     Compiled (:func:`_first_per_cell`): the same indices as NumPy's ``np.unique`` on the
     cells (:func:`_voxel_index_numpy`), a tenth of the time on a scan."""
@@ -50,7 +60,7 @@ def _voxel_index_numpy(points: ArrayLike, size: float) -> NDArray[np.intp]:
     """:func:`voxel_index` by ``np.unique`` (the kernel's reference in the tests, and the
     way for points whose cells an int64 does not hold)."""
     p = np.asarray(points, dtype=float).reshape(-1, 2)
-    k = np.floor(p / size).astype(np.int64)
+    k = np.floor(p / size + VOXEL_PHASE).astype(np.int64)
     k -= k.min(axis=0)
     _, first = np.unique(k[:, 0] * (int(k[:, 1].max()) + 1) + k[:, 1], return_index=True)
     return np.sort(first)
@@ -65,7 +75,8 @@ def _first_per_cell(p, size):  # pragma: no cover
     kx = np.empty(n, np.int64)
     ky = np.empty(n, np.int64)
     for i in range(n):
-        fx, fy = np.floor(p[i, 0] / size), np.floor(p[i, 1] / size)
+        fx = np.floor(p[i, 0] / size + VOXEL_PHASE)
+        fy = np.floor(p[i, 1] / size + VOXEL_PHASE)
         if not (abs(fx) < 2.0**52 and abs(fy) < 2.0**52):
             return None
         kx[i], ky[i] = np.int64(fx), np.int64(fy)

@@ -20,7 +20,7 @@ __all__ = ["Refinement", "refine"]
 
 @njit(cache=True, nogil=True)
 def _accumulate(
-    q0, x, y, th, pts, nrm, lo, cell, nx, ny, starts, order, max_d, huber
+    q0, x, y, th, pts, nrm, lo, cell, nx, ny, starts, order, max_d, huber, soft
 ):  # pragma: no cover
     """One Gauss-Newton round of :func:`refine`: each query point at the pose ``(x, y, th)``
     paired with its nearest map point closer than ``max_d``; returns the weighted normal
@@ -72,19 +72,58 @@ def _accumulate(
                             best, bj = d2, j
         if bj < 0:
             continue
-        nx_, ny_ = nrm[bj, 0], nrm[bj, 1]
-        r = nx_ * (qx - pts[bj, 0]) + ny_ * (qy - pts[bj, 1])
-        jac[0], jac[1] = nx_, ny_
-        jac[2] = ny_ * (qx - x) - nx_ * (qy - y)
-        # Huber on the residual, tapered to 0 at max_d: a pair forming or breaking at the
-        # cut-off changes nothing abruptly
-        w = min(1.0, huber / max(abs(r), 1e-12)) * (1.0 - best / (max_d * max_d)) ** 2
+        # every map point within ``soft`` of the nearest distance shares the point, weighted
+        # by a kernel of its extra distance: a point halfway between two map points of
+        # different normals moves from one to the other continuously, never by a flip
+        dmin = np.sqrt(best)
+        bound = min(dmin + soft, max_d)
+        bound2 = bound * bound
+        rb = int(np.ceil(bound / cell))
+        kh = np.zeros((3, 3))
+        kg = np.zeros(3)
+        ksum, kss = 0.0, 0.0
+        for u in range(max(ix - rb, 0), min(ix + rb + 1, nx)):
+            gx = 0.0 if u == ix else ((u - ix) * cell - ax if u > ix else ax + (ix - u - 1) * cell)
+            for v in range(max(iy - rb, 0), min(iy + rb + 1, ny)):
+                gy = (
+                    0.0
+                    if v == iy
+                    else ((v - iy) * cell - ay if v > iy else ay + (iy - v - 1) * cell)
+                )
+                if gx * gx + gy * gy > bound2 * (1 + 1e-9) + 1e-18:
+                    continue
+                cc = u * ny + v
+                for t in range(starts[cc], starts[cc + 1]):
+                    j = order[t]
+                    dx, dy = qx - pts[j, 0], qy - pts[j, 1]
+                    d2 = dx * dx + dy * dy
+                    if d2 >= bound2:
+                        continue
+                    e = (np.sqrt(d2) - dmin) / soft
+                    if e >= 1.0:
+                        continue
+                    k = (1.0 - e * e) ** 2
+                    nx_, ny_ = nrm[j, 0], nrm[j, 1]
+                    r = nx_ * dx + ny_ * dy
+                    jac[0], jac[1] = nx_, ny_
+                    jac[2] = ny_ * (qx - x) - nx_ * (qy - y)
+                    # Huber on the residual, tapered to 0 at max_d: a pair forming or
+                    # breaking at the cut-off changes nothing abruptly
+                    w = k * min(1.0, huber / max(abs(r), 1e-12)) * (1.0 - d2 / (max_d * max_d)) ** 2
+                    for a in range(3):
+                        kg[a] += w * jac[a] * r
+                        for b in range(3):
+                            kh[a, b] += w * jac[a] * jac[b]
+                    ksum += k
+                    kss += k * r * r
+        if ksum <= 0.0:
+            continue
         for a in range(3):
-            g[a] += w * jac[a] * r
+            g[a] += kg[a] / ksum
             for b in range(3):
-                h[a, b] += w * jac[a] * jac[b]
+                h[a, b] += kh[a, b] / ksum
         n_ok += 1
-        ss += r * r
+        ss += kss / ksum
     return h, g, n_ok, ss
 
 
@@ -107,6 +146,7 @@ def refine(
     max_distance: float = 0.1,
     iterations: int = 10,
     huber: float = 0.02,
+    soft: float = 0.03,
     min_eigen_ratio: float = 1e-3,
     prior: tuple[ArrayLike, ArrayLike] | None = None,
 ) -> Refinement:
@@ -140,7 +180,7 @@ def refine(
     x, h, n_ok, rms = _gauss_newton(
         np.ascontiguousarray(q0), x, target.points, target.normals, target.origin,
         target.cell, nx, ny, target.starts, target.order, float(max_distance), float(huber),
-        int(iterations), float(min_eigen_ratio), prior is not None,
+        float(soft), int(iterations), float(min_eigen_ratio), prior is not None,
         np.ascontiguousarray(prior_pose), np.ascontiguousarray(prior_info),
     )  # fmt: skip
     return Refinement(x, h, int(n_ok), float(rms))
@@ -205,6 +245,7 @@ def _gauss_newton(
     order,
     max_d,
     huber,
+    soft,
     iterations,
     min_eigen_ratio,
     use_prior,
@@ -219,7 +260,7 @@ def _gauss_newton(
     h, n_ok, rms = np.zeros((3, 3)), 0, 0.0
     for it in range(iterations):
         h, g, n_ok, ss = _accumulate(
-            q0, x[0], x[1], x[2], pts, nrm, lo, cell, nx, ny, starts, order, max_d, huber
+            q0, x[0], x[1], x[2], pts, nrm, lo, cell, nx, ny, starts, order, max_d, huber, soft
         )
         if n_ok < 10:
             return x, np.zeros((3, 3)), n_ok, 0.0

@@ -9,6 +9,7 @@ import pytest
 
 from fhslam.geometry import compose, inverse, transform_points
 from fhslam.scanmatch import LikelihoodGrid, match_clouds, voxel_downsample
+from fhslam.scanmatch.clouds import VOXEL_PHASE, voxel_index
 
 
 def _room(step=0.02):
@@ -83,9 +84,23 @@ def test_grid_score_and_voxel_downsample():
     assert grid.score(room, [0, 0, 0]) > 0.95
     assert grid.score(room, [0.2, 0, 0]) < grid.score(room, [0.02, 0, 0])
     v = voxel_downsample(room, 0.1)
-    cells = np.floor(v / 0.1).astype(int)
+    cells = np.floor(v / 0.1 + VOXEL_PHASE).astype(int)
     assert len(np.unique(cells, axis=0)) == len(v)  # one point per cell
-    assert len(np.unique(np.floor(room / 0.1).astype(int), axis=0)) == len(v)  # every cell
+    assert len(np.unique(np.floor(room / 0.1 + VOXEL_PHASE).astype(int), axis=0)) == len(v)
+
+
+def test_voxel_cells_keep_points_on_the_axes_and_at_round_ranges_off_their_borders():
+    """A beam straight ahead (``y = 0``) at whole-millimetre ranges, moved by the last bits a
+    pose can carry, keeps the same first point per cell: no cell border within 0.09 mm of
+    such a point, for cells of 1 to 10 cm."""
+    x = np.arange(1, 20001) * 1e-3  # every millimetre to 20 m
+    beam = np.column_stack([x, np.zeros_like(x)])
+    for size in (0.01, 0.02, 0.025, 0.05, 0.1):
+        f = beam / size + VOXEL_PHASE
+        assert np.min(np.abs(f - np.round(f)) * size) > 0.9e-4, size
+        kept = voxel_index(beam, size)
+        for eps in (1e-15, -1e-15, 1e-12, -1e-12):
+            np.testing.assert_array_equal(voxel_index(beam + eps, size), kept)
 
 
 def test_likelihood_grid_is_a_function_of_exact_squared_distances():
@@ -148,6 +163,23 @@ def test_refine_recovers_a_small_offset_to_a_millimetre(offset):
     assert r.n_matched >= 0.7 * len(query) and r.rms <= 0.003
     # a room constrains every direction: the information is positive definite
     assert np.linalg.eigvalsh(r.hessian).min() > 0
+
+
+def test_refine_moves_by_a_last_bit_where_a_point_lies_halfway_between_two_walls():
+    """A query point as near to a floor point as to a wall point (normals 90° apart): a
+    guess moved by 1e-13 m either way moves the refined pose by about as much (with the
+    nearest neighbour alone, the point's line flips, and the pose by 4 mm)."""
+    from fhslam.scanmatch import PointMap, refine
+
+    s = np.arange(0.0, 2.0, 0.02)
+    floor = np.column_stack([s, 0 * s])
+    wall = np.column_stack([0 * s[1:], s[1:]])
+    normals = np.vstack([np.tile([0.0, 1.0], (len(s), 1)), np.tile([1.0, 0.0], (len(s) - 1, 1))])
+    target = PointMap.build(np.vstack([floor, wall]), normals)
+    query = np.vstack([floor[10::7], wall[10::7], [[0.05, 0.05]]])
+    poses = [refine(target, query, [e, 0.0, 0.0]).pose for e in (-1e-13, 0.0, 1e-13)]
+    assert np.abs(poses[0] - poses[2]).max() < 1e-11
+    assert np.abs(poses[1] - poses[0]).max() < 1e-11
 
 
 def test_refine_in_a_corridor_keeps_the_guess_along_it_and_says_so():

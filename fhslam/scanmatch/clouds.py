@@ -30,20 +30,20 @@ __all__ = [
 VOXEL_PHASE = (3 - 5**0.5) / 2
 """The cells' corners lie this fraction of a cell (0.382) off the frame's axes and round
 coordinates: a point on an axis (a laser's beam straight ahead, ``y = 0`` in its frame) or at
-a quantised range (whole centimetres or millimetres) sits at least a third of a millimetre
-inside a cell of 1-5 cm, not on a border where the last bit of its pose picks the cell."""
+a quantised range (whole centimetres or millimetres) sits a tenth of a millimetre or more
+inside a cell of 1-10 cm, not on a border where the last bit of its pose picks the cell."""
 
 
 def voxel_downsample(points: ArrayLike, size: float) -> NDArray[np.float64]:
     """Keep the first point of each ``size`` × ``size`` cell (order preserved; the cells'
-    corners at ``(k + VOXEL_PHASE) · size``)."""
+    corners at ``(k - VOXEL_PHASE) · size``)."""
     p = np.asarray(points, dtype=float).reshape(-1, 2)
     return p[voxel_index(p, size)]
 
 
 def voxel_index(points: ArrayLike, size: float) -> NDArray[np.intp]:
     """Indices of the first point of each ``size`` × ``size`` cell (corners at
-    ``(k + VOXEL_PHASE) · size``), increasing.
+    ``(k - VOXEL_PHASE) · size``), increasing.
 
     Compiled (:func:`_first_per_cell`): the same indices as NumPy's ``np.unique`` on the
     cells (:func:`_voxel_index_numpy`), a tenth of the time on a scan."""

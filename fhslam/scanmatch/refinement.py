@@ -1,6 +1,6 @@
 """Point-to-line refinement: the pose of a query cloud against a
-:class:`fhslam.scanmatch.grids.PointMap`, by Gauss-Newton rounds of nearest-neighbour pairs
-(compiled, rounded as the NumPy and LAPACK code they replace, bit for bit).
+:class:`fhslam.scanmatch.grids.PointMap`, by Gauss-Newton rounds of soft nearest-neighbour
+pairs (compiled; the steps rounded as NumPy's and LAPACK's, bit for bit).
 """
 
 from __future__ import annotations
@@ -18,104 +18,116 @@ from fhslam.scanmatch.grids import PointMap
 __all__ = ["Refinement", "refine"]
 
 
+@njit(cache=True, nogil=True, inline="always")
+def _gap(u, i, a, cell):  # pragma: no cover
+    """Distance along one axis from a point ``a`` metres into cell ``i`` to cell ``u``."""
+    if u == i:
+        return 0.0
+    return (u - i) * cell - a if u > i else a + (i - u - 1) * cell
+
+
 @njit(cache=True, nogil=True)
-def _accumulate(
-    q0, x, y, th, pts, nrm, lo, cell, nx, ny, starts, order, max_d, huber, soft
-):  # pragma: no cover
-    """One Gauss-Newton round of :func:`refine`: each query point at the pose ``(x, y, th)``
-    paired with its nearest map point closer than ``max_d``; returns the weighted normal
-    equations ``(H, g)``, the number of pairs and the sum of squared residuals."""
-    h = np.zeros((3, 3))
-    g = np.zeros(3)
-    c, s = np.cos(th), np.sin(th)
-    reach = int(np.ceil(max_d / cell))
-    n_ok, ss = 0, 0.0
-    jac = np.empty(3)
-    for k in range(q0.shape[0]):
-        qx = c * q0[k, 0] - s * q0[k, 1] + x
-        qy = s * q0[k, 0] + c * q0[k, 1] + y
-        ix = int(np.floor((qx - lo[0]) / cell))
-        iy = int(np.floor((qy - lo[1]) / cell))
-        best, bj = max_d * max_d, -1
-        # cells in rings around the point's own; a cell (or a ring) whose nearest edge is
-        # farther than the best pair so far cannot hold a nearer point (the margin covers
-        # rounding in the cell index)
-        ax, ay = qx - lo[0] - ix * cell, qy - lo[1] - iy * cell
-        for r in range(reach + 1):
-            if r >= 2 and ((r - 1) * cell) ** 2 > best * (1 + 1e-9) + 1e-18:
-                break
-            for u in range(ix - r, ix + r + 1):
-                if u < 0 or u >= nx:
+def _nearest_d2(qx, qy, pts, lo, cell, nx, ny, starts, order, max_d):  # pragma: no cover
+    """The squared distance of ``(qx, qy)`` to its nearest map point, ``max_d²`` if none is
+    nearer. Cells in rings around the point's own; a cell (or a ring) whose nearest edge is
+    farther than the best so far cannot hold a nearer point (the margin covers rounding in
+    the cell index)."""
+    ix, iy = int(np.floor((qx - lo[0]) / cell)), int(np.floor((qy - lo[1]) / cell))
+    ax, ay = qx - lo[0] - ix * cell, qy - lo[1] - iy * cell
+    best = max_d * max_d
+    for r in range(int(np.ceil(max_d / cell)) + 1):
+        if r >= 2 and ((r - 1) * cell) ** 2 > best * (1 + 1e-9) + 1e-18:
+            break
+        for u in range(max(ix - r, 0), min(ix + r + 1, nx)):
+            gx = _gap(u, ix, ax, cell)
+            step = 1 if abs(u - ix) == r else 2 * r
+            for v in range(iy - r, iy + r + 1, max(step, 1)):
+                if v < 0 or v >= ny:
                     continue
-                gx = (
-                    0.0
-                    if u == ix
-                    else ((u - ix) * cell - ax if u > ix else ax + (ix - u - 1) * cell)
-                )
-                step = 1 if abs(u - ix) == r else 2 * r
-                for v in range(iy - r, iy + r + 1, max(step, 1)):
-                    if v < 0 or v >= ny:
-                        continue
-                    gy = (
-                        0.0
-                        if v == iy
-                        else ((v - iy) * cell - ay if v > iy else ay + (iy - v - 1) * cell)
-                    )
-                    if gx * gx + gy * gy > best * (1 + 1e-9) + 1e-18:
-                        continue
-                    cc = u * ny + v
-                    for t in range(starts[cc], starts[cc + 1]):
-                        j = order[t]
-                        dx, dy = qx - pts[j, 0], qy - pts[j, 1]
-                        d2 = dx * dx + dy * dy
-                        if d2 < best or (d2 == best and bj >= 0 and j < bj):
-                            best, bj = d2, j
-        if bj < 0:
-            continue
-        # every map point within ``soft`` of the nearest distance shares the point, weighted
-        # by a kernel of its extra distance: a point halfway between two map points of
-        # different normals moves from one to the other continuously, never by a flip
-        dmin = np.sqrt(best)
-        bound = min(dmin + soft, max_d)
-        bound2 = bound * bound
-        rb = int(np.ceil(bound / cell))
-        kh = np.zeros((3, 3))
-        kg = np.zeros(3)
-        ksum, kss = 0.0, 0.0
-        for u in range(max(ix - rb, 0), min(ix + rb + 1, nx)):
-            gx = 0.0 if u == ix else ((u - ix) * cell - ax if u > ix else ax + (ix - u - 1) * cell)
-            for v in range(max(iy - rb, 0), min(iy + rb + 1, ny)):
-                gy = (
-                    0.0
-                    if v == iy
-                    else ((v - iy) * cell - ay if v > iy else ay + (iy - v - 1) * cell)
-                )
-                if gx * gx + gy * gy > bound2 * (1 + 1e-9) + 1e-18:
+                gy = _gap(v, iy, ay, cell)
+                if gx * gx + gy * gy > best * (1 + 1e-9) + 1e-18:
                     continue
                 cc = u * ny + v
                 for t in range(starts[cc], starts[cc + 1]):
                     j = order[t]
                     dx, dy = qx - pts[j, 0], qy - pts[j, 1]
-                    d2 = dx * dx + dy * dy
-                    if d2 >= bound2:
-                        continue
-                    e = (np.sqrt(d2) - dmin) / soft
-                    if e >= 1.0:
-                        continue
-                    k = (1.0 - e * e) ** 2
-                    nx_, ny_ = nrm[j, 0], nrm[j, 1]
-                    r = nx_ * dx + ny_ * dy
-                    jac[0], jac[1] = nx_, ny_
-                    jac[2] = ny_ * (qx - x) - nx_ * (qy - y)
-                    # Huber on the residual, tapered to 0 at max_d: a pair forming or
-                    # breaking at the cut-off changes nothing abruptly
-                    w = k * min(1.0, huber / max(abs(r), 1e-12)) * (1.0 - d2 / (max_d * max_d)) ** 2
-                    for a in range(3):
-                        kg[a] += w * jac[a] * r
-                        for b in range(3):
-                            kh[a, b] += w * jac[a] * jac[b]
-                    ksum += k
-                    kss += k * r * r
+                    best = min(best, dx * dx + dy * dy)
+    return best
+
+
+@njit(cache=True, nogil=True)
+def _soft_pairs(
+    qx, qy, x, y, dmin, pts, nrm, lo, cell, nx, ny, starts, order, max_d, huber, soft, kh, kg
+):  # pragma: no cover
+    """Add the pairs of ``(qx, qy)`` (nearest map point ``dmin`` away) with the map points
+    less than ``soft`` farther, each weighted by its kernel, Huber weight and taper, to
+    ``kh`` and ``kg``; returns the sum of the kernels and of kernel × squared residual."""
+    ix, iy = int(np.floor((qx - lo[0]) / cell)), int(np.floor((qy - lo[1]) / cell))
+    ax, ay = qx - lo[0] - ix * cell, qy - lo[1] - iy * cell
+    bound = min(dmin + soft, max_d)
+    bound2 = bound * bound
+    rb = int(np.ceil(bound / cell))
+    ksum, kss = 0.0, 0.0
+    jac = np.empty(3)
+    for u in range(max(ix - rb, 0), min(ix + rb + 1, nx)):
+        gx = _gap(u, ix, ax, cell)
+        for v in range(max(iy - rb, 0), min(iy + rb + 1, ny)):
+            gy = _gap(v, iy, ay, cell)
+            if gx * gx + gy * gy > bound2 * (1 + 1e-9) + 1e-18:
+                continue
+            cc = u * ny + v
+            for t in range(starts[cc], starts[cc + 1]):
+                j = order[t]
+                dx, dy = qx - pts[j, 0], qy - pts[j, 1]
+                d2 = dx * dx + dy * dy
+                e = (np.sqrt(d2) - dmin) / soft
+                if d2 >= bound2 or e >= 1.0:
+                    continue
+                k = (1.0 - e * e) ** 2
+                r = nrm[j, 0] * dx + nrm[j, 1] * dy
+                jac[0], jac[1] = nrm[j, 0], nrm[j, 1]
+                jac[2] = nrm[j, 1] * (qx - x) - nrm[j, 0] * (qy - y)
+                # Huber on the residual, tapered to 0 at max_d: a pair forming or breaking
+                # at the cut-off changes nothing abruptly
+                w = k * min(1.0, huber / max(abs(r), 1e-12)) * (1.0 - d2 / (max_d * max_d)) ** 2
+                for a in range(3):
+                    kg[a] += w * jac[a] * r
+                    for b in range(3):
+                        kh[a, b] += w * jac[a] * jac[b]
+                ksum += k
+                kss += k * r * r
+    return ksum, kss
+
+
+@njit(cache=True, nogil=True)
+def _accumulate(
+    q0, x, y, th, pts, nrm, lo, cell, nx, ny, starts, order, max_d, huber, soft
+):  # pragma: no cover
+    """One Gauss-Newton round of :func:`refine`: each query point at the pose ``(x, y, th)``
+    whose nearest map point lies closer than ``max_d`` is paired with every map point less
+    than ``soft`` farther than that one, weighted by ``(1 - (extra / soft)²)²`` (the
+    weights of a point sum to one: a point halfway between two map points of different
+    normals moves from one to the other continuously, never by a flip); returns the
+    weighted normal equations ``(H, g)``, the number of query points paired and the sum of
+    their (weighted) squared residuals."""
+    h = np.zeros((3, 3))
+    g = np.zeros(3)
+    kh = np.empty((3, 3))
+    kg = np.empty(3)
+    c, s = np.cos(th), np.sin(th)
+    n_ok, ss = 0, 0.0
+    for k in range(q0.shape[0]):
+        qx = c * q0[k, 0] - s * q0[k, 1] + x
+        qy = s * q0[k, 0] + c * q0[k, 1] + y
+        best = _nearest_d2(qx, qy, pts, lo, cell, nx, ny, starts, order, max_d)
+        if best >= max_d * max_d:
+            continue
+        kh[:, :] = 0.0
+        kg[:] = 0.0
+        ksum, kss = _soft_pairs(
+            qx, qy, x, y, np.sqrt(best), pts, nrm, lo, cell, nx, ny, starts, order, max_d,
+            huber, soft, kh, kg,
+        )  # fmt: skip
         if ksum <= 0.0:
             continue
         for a in range(3):
@@ -146,19 +158,22 @@ def refine(
     max_distance: float = 0.1,
     iterations: int = 10,
     huber: float = 0.02,
-    soft: float = 0.03,
+    soft: float = 0.01,
     min_eigen_ratio: float = 1e-3,
     prior: tuple[ArrayLike, ArrayLike] | None = None,
 ) -> Refinement:
     """Point-to-line ICP: the pose of ``query`` in ``target``'s frame near ``guess``.
 
-    Each query point is paired with its nearest target point within ``max_distance``; the
-    pose minimises the weighted squared distances of the query points to those points'
-    tangent lines (Gauss-Newton, a fixed number of rounds: Huber weights, tapered to zero at
-    ``max_distance``). Along a direction the pairs do
-    not constrain (a corridor's axis: eigenvalue under ``min_eigen_ratio`` of the largest)
-    the guess is kept; :attr:`Refinement.hessian` tells the caller how little is known
-    there.
+    Each query point is paired with its nearest target point within ``max_distance`` and,
+    with weights that fall smoothly to zero, with the target points less than ``soft``
+    metres farther than that one: a query point halfway between two target points of
+    different normals passes from one to the other continuously, so a last-bit change of
+    ``guess`` or of the target moves the result by about as much, not by a flip of the
+    nearest neighbour. The pose minimises the weighted squared distances of the query points
+    to those points' tangent lines (Gauss-Newton, a fixed number of rounds: Huber weights,
+    tapered to zero at ``max_distance``). Along a direction the pairs do not constrain (a
+    corridor's axis: eigenvalue under ``min_eigen_ratio`` of the largest) the guess is kept;
+    :attr:`Refinement.hessian` tells the caller how little is known there.
 
     ``prior=(pose, information)`` adds ``(x - pose)ᵀ information (x - pose)`` to the cost
     (information in the residuals' units, 1/m² per squared metre of residual): where the

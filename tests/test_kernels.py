@@ -722,7 +722,9 @@ def test_fma_rounds_once(fma):
     assert (1 + e) * (1 + e) - (1 + 2 * e) == 0.0 and fma(1 + e, 1 + e, -(1 + 2 * e)) == e * e
 
 
-def _numpy_rounds(target, query, guess, prior=None, iterations=10, max_d=0.1, huber=0.02):
+def _numpy_rounds(
+    target, query, guess, prior=None, iterations=10, max_d=0.1, huber=0.02, soft=0.01
+):
     """:func:`refine`'s rounds as they were written in NumPy (the reference)."""
     q0 = np.ascontiguousarray(query)
     x = np.asarray(guess, dtype=float).copy()
@@ -731,7 +733,7 @@ def _numpy_rounds(target, query, guess, prior=None, iterations=10, max_d=0.1, hu
     for it in range(iterations):
         h, g, n_ok, _ = _accumulate(
             q0, x[0], x[1], x[2], target.points, target.normals, target.origin, target.cell,
-            nx, ny, target.starts, target.order, max_d, huber,
+            nx, ny, target.starts, target.order, max_d, huber, soft,
         )  # fmt: skip
         if n_ok < 10:
             return x, np.zeros((3, 3))

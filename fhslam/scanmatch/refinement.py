@@ -27,16 +27,19 @@ def _gap(u, i, a, cell):  # pragma: no cover
 
 
 @njit(cache=True, nogil=True)
-def _nearest_d2(qx, qy, pts, lo, cell, nx, ny, starts, order, max_d):  # pragma: no cover
-    """The squared distance of ``(qx, qy)`` to its nearest map point, ``max_d²`` if none is
-    nearer. Cells in rings around the point's own; a cell (or a ring) whose nearest edge is
-    farther than the best so far cannot hold a nearer point (the margin covers rounding in
-    the cell index)."""
+def _candidates(
+    qx, qy, pts, lo, cell, nx, ny, starts, order, max_d, soft, cand_j, cand_d2
+):  # pragma: no cover
+    """The map points that may pair with ``(qx, qy)``: those within ``soft`` of the nearest
+    distance so far (into ``cand_j``, ``cand_d2``). Returns their number and the nearest
+    squared distance (``max_d²`` if no point is nearer). Cells in rings around the point's
+    own; a cell (or a ring) whose nearest edge is farther than that bound cannot hold a
+    candidate (the margin covers rounding in the cell index)."""
     ix, iy = int(np.floor((qx - lo[0]) / cell)), int(np.floor((qy - lo[1]) / cell))
     ax, ay = qx - lo[0] - ix * cell, qy - lo[1] - iy * cell
-    best = max_d * max_d
+    best, bound2, m = max_d * max_d, max_d * max_d, 0
     for r in range(int(np.ceil(max_d / cell)) + 1):
-        if r >= 2 and ((r - 1) * cell) ** 2 > best * (1 + 1e-9) + 1e-18:
+        if r >= 2 and ((r - 1) * cell) ** 2 > bound2 * (1 + 1e-9) + 1e-18:
             break
         for u in range(max(ix - r, 0), min(ix + r + 1, nx)):
             gx = _gap(u, ix, ax, cell)
@@ -45,57 +48,54 @@ def _nearest_d2(qx, qy, pts, lo, cell, nx, ny, starts, order, max_d):  # pragma:
                 if v < 0 or v >= ny:
                     continue
                 gy = _gap(v, iy, ay, cell)
-                if gx * gx + gy * gy > best * (1 + 1e-9) + 1e-18:
+                if gx * gx + gy * gy > bound2 * (1 + 1e-9) + 1e-18:
                     continue
                 cc = u * ny + v
                 for t in range(starts[cc], starts[cc + 1]):
                     j = order[t]
                     dx, dy = qx - pts[j, 0], qy - pts[j, 1]
-                    best = min(best, dx * dx + dy * dy)
-    return best
+                    d2 = dx * dx + dy * dy
+                    if d2 >= bound2:
+                        continue
+                    cand_j[m], cand_d2[m] = j, d2
+                    m += 1
+                    if d2 < best:
+                        best = d2
+                        bound2 = min((np.sqrt(d2) + soft) ** 2, max_d * max_d)
+    return m, best
 
 
 @njit(cache=True, nogil=True)
 def _soft_pairs(
-    qx, qy, x, y, dmin, pts, nrm, lo, cell, nx, ny, starts, order, max_d, huber, soft, kh, kg
+    qx, qy, x, y, m, best, cand_j, cand_d2, pts, nrm, max_d, huber, soft, kh, kg
 ):  # pragma: no cover
-    """Add the pairs of ``(qx, qy)`` (nearest map point ``dmin`` away) with the map points
-    less than ``soft`` farther, each weighted by its kernel, Huber weight and taper, to
-    ``kh`` and ``kg``; returns the sum of the kernels and of kernel × squared residual."""
-    ix, iy = int(np.floor((qx - lo[0]) / cell)), int(np.floor((qy - lo[1]) / cell))
-    ax, ay = qx - lo[0] - ix * cell, qy - lo[1] - iy * cell
+    """Add the pairs of ``(qx, qy)`` with its ``m`` candidates less than ``soft`` farther
+    than the nearest (``best``: squared distance), each weighted by its kernel, Huber
+    weight and taper, to ``kh`` and ``kg``; returns the sum of the kernels and of kernel ×
+    squared residual."""
+    dmin = np.sqrt(best)
     bound = min(dmin + soft, max_d)
-    bound2 = bound * bound
-    rb = int(np.ceil(bound / cell))
     ksum, kss = 0.0, 0.0
     jac = np.empty(3)
-    for u in range(max(ix - rb, 0), min(ix + rb + 1, nx)):
-        gx = _gap(u, ix, ax, cell)
-        for v in range(max(iy - rb, 0), min(iy + rb + 1, ny)):
-            gy = _gap(v, iy, ay, cell)
-            if gx * gx + gy * gy > bound2 * (1 + 1e-9) + 1e-18:
-                continue
-            cc = u * ny + v
-            for t in range(starts[cc], starts[cc + 1]):
-                j = order[t]
-                dx, dy = qx - pts[j, 0], qy - pts[j, 1]
-                d2 = dx * dx + dy * dy
-                e = (np.sqrt(d2) - dmin) / soft
-                if d2 >= bound2 or e >= 1.0:
-                    continue
-                k = (1.0 - e * e) ** 2
-                r = nrm[j, 0] * dx + nrm[j, 1] * dy
-                jac[0], jac[1] = nrm[j, 0], nrm[j, 1]
-                jac[2] = nrm[j, 1] * (qx - x) - nrm[j, 0] * (qy - y)
-                # Huber on the residual, tapered to 0 at max_d: a pair forming or breaking
-                # at the cut-off changes nothing abruptly
-                w = k * min(1.0, huber / max(abs(r), 1e-12)) * (1.0 - d2 / (max_d * max_d)) ** 2
-                for a in range(3):
-                    kg[a] += w * jac[a] * r
-                    for b in range(3):
-                        kh[a, b] += w * jac[a] * jac[b]
-                ksum += k
-                kss += k * r * r
+    for t in range(m):
+        j, d2 = cand_j[t], cand_d2[t]
+        e = (np.sqrt(d2) - dmin) / soft
+        if d2 >= bound * bound or e >= 1.0:
+            continue
+        k = (1.0 - e * e) ** 2
+        dx, dy = qx - pts[j, 0], qy - pts[j, 1]
+        r = nrm[j, 0] * dx + nrm[j, 1] * dy
+        jac[0], jac[1] = nrm[j, 0], nrm[j, 1]
+        jac[2] = nrm[j, 1] * (qx - x) - nrm[j, 0] * (qy - y)
+        # Huber on the residual, tapered to 0 at max_d: a pair forming or breaking at the
+        # cut-off changes nothing abruptly
+        w = k * min(1.0, huber / max(abs(r), 1e-12)) * (1.0 - d2 / (max_d * max_d)) ** 2
+        for a in range(3):
+            kg[a] += w * jac[a] * r
+            for b in range(3):
+                kh[a, b] += w * jac[a] * jac[b]
+        ksum += k
+        kss += k * r * r
     return ksum, kss
 
 
@@ -114,22 +114,23 @@ def _accumulate(
     g = np.zeros(3)
     kh = np.empty((3, 3))
     kg = np.empty(3)
+    cand_j = np.empty(pts.shape[0], np.int64)
+    cand_d2 = np.empty(pts.shape[0])
     c, s = np.cos(th), np.sin(th)
     n_ok, ss = 0, 0.0
     for k in range(q0.shape[0]):
         qx = c * q0[k, 0] - s * q0[k, 1] + x
         qy = s * q0[k, 0] + c * q0[k, 1] + y
-        best = _nearest_d2(qx, qy, pts, lo, cell, nx, ny, starts, order, max_d)
+        m, best = _candidates(
+            qx, qy, pts, lo, cell, nx, ny, starts, order, max_d, soft, cand_j, cand_d2
+        )
         if best >= max_d * max_d:
             continue
         kh[:, :] = 0.0
         kg[:] = 0.0
         ksum, kss = _soft_pairs(
-            qx, qy, x, y, np.sqrt(best), pts, nrm, lo, cell, nx, ny, starts, order, max_d,
-            huber, soft, kh, kg,
-        )  # fmt: skip
-        if ksum <= 0.0:
-            continue
+            qx, qy, x, y, m, best, cand_j, cand_d2, pts, nrm, max_d, huber, soft, kh, kg
+        )
         for a in range(3):
             g[a] += kg[a] / ksum
             for b in range(3):

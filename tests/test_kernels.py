@@ -27,6 +27,7 @@ from fhslam.scanmatch import (
     voxel_index,
 )
 from fhslam.scanmatch.clouds import (
+    VOXEL_PHASE,
     _bounds,
     _densify_numpy,
     _first_per_cell,
@@ -273,10 +274,11 @@ def test_densify_equals_numpy_bit_for_bit(paper_scans):
 
 
 def _opencv_grid(points, resolution, sigma, margin):
-    """The grid of the previous commit: OpenCV's exact distance transform, its float32
-    distances squared and rounded to integers, looked up in the ``exp`` table."""
+    """The reference grid: OpenCV's exact distance transform, its float32 distances squared
+    and rounded to integers, looked up in the ``exp`` table; cell corners at
+    ``(k - VOXEL_PHASE) · resolution``."""
     p = np.asarray(points, dtype=float)
-    lo = p.min(axis=0) - margin
+    lo = resolution * (np.floor((p.min(axis=0) - margin) / resolution + VOXEL_PHASE) - VOXEL_PHASE)
     shape = np.ceil((p.max(axis=0) + margin - lo) / resolution).astype(int) + 1
     img = np.full((shape[1], shape[0]), 255, np.uint8)
     c = np.floor((p - lo) / resolution).astype(int)
@@ -290,7 +292,7 @@ def _opencv_grid(points, resolution, sigma, margin):
 
 
 def test_likelihood_grid_equals_opencv_construction(paper_scans):
-    """Claim 4: :meth:`LikelihoodGrid.build` gives the previous commit's OpenCV grid,
+    """Claim 4: :meth:`LikelihoodGrid.build` gives the OpenCV reference grid,
     values and origin exactly: several resolutions, sigmas (tables from 2 to 187 000
     entries) and margins (0 included), duplicates, cell boundaries, 1 and 2 points, a
     sparse 30 m cloud, real scans and merged real scans."""

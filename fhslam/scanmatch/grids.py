@@ -18,7 +18,7 @@ from scipy.spatial import cKDTree
 
 from fhslam._numba import njit
 from fhslam.geometry import as_points, as_pose, tls_normal_angle, transform_points
-from fhslam.scanmatch.clouds import _bounds
+from fhslam.scanmatch.clouds import VOXEL_PHASE, _bounds
 
 __all__ = ["BNB_LEVELS", "GRID_PAD", "LikelihoodGrid", "PointMap"]
 
@@ -73,12 +73,16 @@ class LikelihoodGrid:
     def build(
         cls, points: ArrayLike, resolution: float, sigma: float, margin: float
     ) -> LikelihoodGrid:
-        """Rasterise ``points`` (N >= 1, 2) with ``margin`` metres of border."""
+        """Rasterise ``points`` (N >= 1, 2) with at least ``margin`` metres of border, in
+        cells whose corners lie at ``(k - VOXEL_PHASE) · resolution`` of the points' frame."""
         p = as_points(points, "target points")
         if len(p) == 0:
             raise ValueError("target points must not be empty")
         low, high = _bounds(p)
-        lo = low - margin
+        # cell corners at (k - VOXEL_PHASE) · resolution of the points' frame, as the voxels':
+        # anchored to the frame, and no point on a border by construction (the lowest point
+        # sat exactly `margin` from the corner, a whole number of cells for some margins)
+        lo = resolution * (np.floor((low - margin) / resolution + VOXEL_PHASE) - VOXEL_PHASE)
         shape = np.ceil((high + margin - lo) / resolution).astype(int) + 1
         # exp(-d²/2σ²) looked up by the exact integer d² (in cells²); the table runs to where
         # float32 underflows to 0, so the values are exactly those of the formula

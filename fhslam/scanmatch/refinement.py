@@ -28,10 +28,10 @@ def _gap(u, i, a, cell):  # pragma: no cover
 
 @njit(cache=True, nogil=True)
 def _candidates(
-    qx, qy, pts, lo, cell, nx, ny, starts, order, max_d, soft, cand_j, cand_d2
+    qx, qy, pts, lo, cell, nx, ny, starts, order, max_d, soft, cand_j, cand_d
 ):  # pragma: no cover
     """The map points that may pair with ``(qx, qy)``: those within ``soft`` of the nearest
-    distance so far (into ``cand_j``, ``cand_d2``). Returns their number and the nearest
+    distance so far (into ``cand_j``, ``cand_d``: distances). Returns their number and the nearest
     squared distance (``max_d²`` if no point is nearer). Cells in rings around the point's
     own; a cell (or a ring) whose nearest edge is farther than that bound cannot hold a
     candidate (the margin covers rounding in the cell index)."""
@@ -57,7 +57,7 @@ def _candidates(
                     d2 = dx * dx + dy * dy
                     if d2 >= bound2:
                         continue
-                    cand_j[m], cand_d2[m] = j, d2
+                    cand_j[m], cand_d[m] = j, np.sqrt(d2)
                     m += 1
                     if d2 < best:
                         best = d2
@@ -67,36 +67,40 @@ def _candidates(
 
 @njit(cache=True, nogil=True)
 def _soft_pairs(
-    qx, qy, x, y, m, best, cand_j, cand_d2, pts, nrm, max_d, huber, soft, kh, kg
+    qx, qy, x, y, m, best, cand_j, cand_d, pts, nrm, max_d, huber, soft, out
 ):  # pragma: no cover
-    """Add the pairs of ``(qx, qy)`` with its ``m`` candidates less than ``soft`` farther
-    than the nearest (``best``: squared distance), each weighted by its kernel, Huber
-    weight and taper, to ``kh`` and ``kg``; returns the sum of the kernels and of kernel ×
-    squared residual."""
+    """Add the pairs of ``(qx, qy)`` with its ``m`` candidates (at distances ``cand_d``) less
+    than ``soft`` farther than the nearest (``best``: squared distance), each weighted by
+    its kernel over the kernels' sum, its Huber weight and taper, to ``out`` (the upper
+    triangle of ``H``, then ``g``, then the squared residual: ten sums)."""
     dmin = np.sqrt(best)
     bound = min(dmin + soft, max_d)
-    ksum, kss = 0.0, 0.0
-    jac = np.empty(3)
+    ksum = h00 = h01 = h02 = h11 = h12 = h22 = g0 = g1 = g2 = rr = 0.0
     for t in range(m):
-        j, d2 = cand_j[t], cand_d2[t]
-        e = (np.sqrt(d2) - dmin) / soft
-        if d2 >= bound * bound or e >= 1.0:
+        e = (cand_d[t] - dmin) / soft
+        if cand_d[t] >= bound or e >= 1.0:
             continue
+        j = cand_j[t]
         k = (1.0 - e * e) ** 2
-        dx, dy = qx - pts[j, 0], qy - pts[j, 1]
-        r = nrm[j, 0] * dx + nrm[j, 1] * dy
-        jac[0], jac[1] = nrm[j, 0], nrm[j, 1]
-        jac[2] = nrm[j, 1] * (qx - x) - nrm[j, 0] * (qy - y)
+        nx_, ny_ = nrm[j, 0], nrm[j, 1]
+        r = nx_ * (qx - pts[j, 0]) + ny_ * (qy - pts[j, 1])
+        j2 = ny_ * (qx - x) - nx_ * (qy - y)
         # Huber on the residual, tapered to 0 at max_d: a pair forming or breaking at the
         # cut-off changes nothing abruptly
-        w = k * min(1.0, huber / max(abs(r), 1e-12)) * (1.0 - d2 / (max_d * max_d)) ** 2
-        for a in range(3):
-            kg[a] += w * jac[a] * r
-            for b in range(3):
-                kh[a, b] += w * jac[a] * jac[b]
+        w = k * min(1.0, huber / max(abs(r), 1e-12)) * (1.0 - (cand_d[t] / max_d) ** 2) ** 2
+        h00 += w * nx_ * nx_
+        h01 += w * nx_ * ny_
+        h02 += w * nx_ * j2
+        h11 += w * ny_ * ny_
+        h12 += w * ny_ * j2
+        h22 += w * j2 * j2
+        g0 += w * nx_ * r
+        g1 += w * ny_ * r
+        g2 += w * j2 * r
+        rr += k * r * r
         ksum += k
-        kss += k * r * r
-    return ksum, kss
+    for i, v in enumerate((h00, h01, h02, h11, h12, h22, g0, g1, g2, rr)):
+        out[i] += v / ksum
 
 
 @njit(cache=True, nogil=True)
@@ -110,34 +114,25 @@ def _accumulate(
     normals moves from one to the other continuously, never by a flip); returns the
     weighted normal equations ``(H, g)``, the number of query points paired and the sum of
     their (weighted) squared residuals."""
-    h = np.zeros((3, 3))
-    g = np.zeros(3)
-    kh = np.empty((3, 3))
-    kg = np.empty(3)
+    out = np.zeros(10)
     cand_j = np.empty(pts.shape[0], np.int64)
-    cand_d2 = np.empty(pts.shape[0])
+    cand_d = np.empty(pts.shape[0])
     c, s = np.cos(th), np.sin(th)
-    n_ok, ss = 0, 0.0
+    n_ok = 0
     for k in range(q0.shape[0]):
         qx = c * q0[k, 0] - s * q0[k, 1] + x
         qy = s * q0[k, 0] + c * q0[k, 1] + y
         m, best = _candidates(
-            qx, qy, pts, lo, cell, nx, ny, starts, order, max_d, soft, cand_j, cand_d2
+            qx, qy, pts, lo, cell, nx, ny, starts, order, max_d, soft, cand_j, cand_d
         )
-        if best >= max_d * max_d:
-            continue
-        kh[:, :] = 0.0
-        kg[:] = 0.0
-        ksum, kss = _soft_pairs(
-            qx, qy, x, y, m, best, cand_j, cand_d2, pts, nrm, max_d, huber, soft, kh, kg
-        )
-        for a in range(3):
-            g[a] += kg[a] / ksum
-            for b in range(3):
-                h[a, b] += kh[a, b] / ksum
-        n_ok += 1
-        ss += kss / ksum
-    return h, g, n_ok, ss
+        if best < max_d * max_d:
+            _soft_pairs(qx, qy, x, y, m, best, cand_j, cand_d, pts, nrm, max_d, huber, soft, out)
+            n_ok += 1
+    h = np.empty((3, 3))
+    h[0, 0], h[0, 1], h[0, 2] = out[0], out[1], out[2]
+    h[1, 0], h[1, 1], h[1, 2] = out[1], out[3], out[4]
+    h[2, 0], h[2, 1], h[2, 2] = out[2], out[4], out[5]
+    return h, out[6:9].copy(), n_ok, out[9]
 
 
 @dataclass(frozen=True)

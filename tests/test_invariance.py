@@ -92,9 +92,9 @@ def test_graph_on_the_offices_floor_does_not_depend_on_the_world_frame(motion):
     """The default method runs in its first pose's frame, its voxels offset from that
     frame's axes (:data:`fhslam.scanmatch.clouds.VOXEL_PHASE`) and its point-to-line pairs
     soft: on the ``offices`` floor (its corridor driven back the other way), where the
-    differences in the last bits of a moved world's odometry grew to 4.5 cm through those
-    choices, the poses agree to ``TOL_M`` (measured 4e-14 m) and the ATE is 0.84 cm in every
-    frame (the limit for a simulated world: 2 cm)."""
+    differences in the last bits of a moved world's odometry would grow to centimetres
+    through hard choices, the poses agree to ``TOL_M`` (measured 4e-14 m) and the ATE is
+    0.84 cm in every frame (the limit for a simulated world: 2 cm)."""
     own, _, log = _run("offices", (0.0, 0.0, 0.0), "graph")
     moved, _, _ = _run("offices", motion, "graph")
     dpos, dth = _pose_difference(moved, own)
@@ -107,9 +107,9 @@ def test_graph_on_the_offices_floor_does_not_depend_on_the_world_frame(motion):
 def test_graph_does_not_depend_on_the_odometrys_last_bit(world, seed):
     """The odometry multiplied by (1 + 1e-15 ε), what another CPU may do: no decision of the
     default method (keyframe, voxel, grid cell, point-to-line pair, closure) flips on it, so
-    the poses stay within ``TOL_M`` (measured at most 9e-14 m on the offices floor and the paper
-    world, where draws like these moved the paper world's ATE by up to 1.5 cm when a voxel
-    border or a nearest neighbour could flip)."""
+    the poses stay within ``TOL_M`` (measured at most 9e-14 m on the offices floor and the
+    paper world; a voxel border on the laser's axis, or a nearest neighbour chosen at a tie,
+    would flip on it and move the paper world's ATE by centimetres)."""
     own, _, log = _run(world, (0.0, 0.0, 0.0), "graph")
     r = run_slam(perturb_odometry(log, seed), "graph")
     dpos, dth = _pose_difference(r.poses, own)

@@ -50,7 +50,7 @@ MOVED = {
     "loops.growth": 0.1,
     "loops.max_radius": 5.0,
     "loops.target_keyframes": 3,
-    "loops.window": 0.5,
+    "loops.window": 0.2,
     "loops.window_deg": 0.5,
     "loops.min_score": 0.7,
     "loops.max_chi2": 0.01,
@@ -80,7 +80,9 @@ matches."""
 
 ON_A_REAL_LOG = {
     "tracker.window_deg",
+    "tracker.recovery_window",
     "tracker.recovery_window_deg",
+    "loops.growth",
     "loops.window_deg",
     "loops.consistency",
 }

@@ -205,6 +205,9 @@ def test_point_map_and_refine_bad_input():
     with pytest.raises(ValueError, match="2 normals for 3 points"):
         PointMap.build(np.eye(3, 2), np.zeros((2, 2)))
     pm = PointMap.build(_room())
+    for bad in (0.0, -0.01, float("nan")):
+        with pytest.raises(ValueError, match="soft must be > 0"):
+            refine(pm, _room()[:20], [0.0, 0.0, 0.0], soft=bad)
     r = refine(pm, _room()[:5], [0.0, 0.0, 0.0])  # too few pairs: the guess, no information
     assert r.n_matched < 10 and np.array_equal(r.pose, np.zeros(3)) and not r.hessian.any()
 

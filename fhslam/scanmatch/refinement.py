@@ -183,6 +183,8 @@ def refine(
         prior_info = np.asarray(prior[1], dtype=float).reshape(3, 3)
     if not max_distance > 0:
         raise ValueError(f"max_distance must be > 0, got {max_distance}")
+    if not soft > 0:
+        raise ValueError(f"soft must be > 0, got {soft}")
     if len(target.points) == 0 or iterations < 1:
         return Refinement(x, np.zeros((3, 3)), 0, 0.0)
     nx, ny = target.shape

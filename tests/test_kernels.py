@@ -736,6 +736,7 @@ def _numpy_rounds(
         h, g, n_ok, _ = _accumulate(
             q0, x[0], x[1], x[2], target.points, target.normals, target.origin, target.cell,
             nx, ny, target.starts, target.order, max_d, huber, soft,
+            np.empty(len(target.points), np.int64), np.empty(len(target.points)),
         )  # fmt: skip
         if n_ok < 10:
             return x, np.zeros((3, 3))

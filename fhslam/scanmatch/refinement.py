@@ -57,11 +57,12 @@ def _candidates(
                     d2 = dx * dx + dy * dy
                     if d2 >= bound2:
                         continue
-                    cand_j[m], cand_d[m] = j, np.sqrt(d2)
+                    d = np.sqrt(d2)
+                    cand_j[m], cand_d[m] = j, d
                     m += 1
                     if d2 < best:
                         best = d2
-                        bound2 = min((np.sqrt(d2) + soft) ** 2, max_d * max_d)
+                        bound2 = min((d + soft) ** 2, max_d * max_d)
     return m, best
 
 
@@ -105,7 +106,7 @@ def _soft_pairs(
 
 @njit(cache=True, nogil=True)
 def _accumulate(
-    q0, x, y, th, pts, nrm, lo, cell, nx, ny, starts, order, max_d, huber, soft
+    q0, x, y, th, pts, nrm, lo, cell, nx, ny, starts, order, max_d, huber, soft, cand_j, cand_d
 ):  # pragma: no cover
     """One Gauss-Newton round of :func:`refine`: each query point at the pose ``(x, y, th)``
     whose nearest map point lies closer than ``max_d`` is paired with every map point less
@@ -113,10 +114,9 @@ def _accumulate(
     weights of a point sum to one: a point halfway between two map points of different
     normals moves from one to the other continuously, never by a flip); returns the
     weighted normal equations ``(H, g)``, the number of query points paired and the sum of
-    their (weighted) squared residuals."""
+    their (weighted) squared residuals. ``cand_j`` and ``cand_d`` (one entry per map point)
+    are scratch space for :func:`_candidates`."""
     out = np.zeros(10)
-    cand_j = np.empty(pts.shape[0], np.int64)
-    cand_d = np.empty(pts.shape[0])
     c, s = np.cos(th), np.sin(th)
     n_ok = 0
     for k in range(q0.shape[0]):
@@ -271,10 +271,12 @@ def _gauss_newton(
     :func:`_dot_columns`). Returns
     ``(pose, H, pairs, rms)``."""
     h, n_ok, rms = np.zeros((3, 3)), 0, 0.0
+    cand_j, cand_d = np.empty(pts.shape[0], np.int64), np.empty(pts.shape[0])
     for it in range(iterations):
         h, g, n_ok, ss = _accumulate(
-            q0, x[0], x[1], x[2], pts, nrm, lo, cell, nx, ny, starts, order, max_d, huber, soft
-        )
+            q0, x[0], x[1], x[2], pts, nrm, lo, cell, nx, ny, starts, order, max_d, huber, soft,
+            cand_j, cand_d,
+        )  # fmt: skip
         if n_ok < 10:
             return x, np.zeros((3, 3)), n_ok, 0.0
         rms = np.sqrt(ss / n_ok)

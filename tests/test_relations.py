@@ -19,7 +19,13 @@ from fhslam.io import (
     write_trajectory,
 )
 from fhslam.io import write_relations as save_relations
-from fhslam.metrics import RelationsError, relations_error, relations_errors, sample_relations
+from fhslam.metrics import (
+    RelationsError,
+    extend_by_odometry,
+    relations_error,
+    relations_errors,
+    sample_relations,
+)
 
 FIELDS = (
     "trans_mean",
@@ -488,3 +494,36 @@ def test_simulate_relations_measure_a_run_as_a_real_log_is(tmp_path, capsys):
     e = json.loads(capsys.readouterr().out)
     assert e["relations_used"] == e["relations_total"] == 61
     assert e["relations_trans_mean"] == pytest.approx(0.0, abs=1e-9)
+
+
+def test_extend_by_odometry_fills_the_scans_between_by_the_odometry():
+    """Scans between two trajectory scans get the earlier one's pose moved by the odometry:
+    a trajectory that is the odometry moved rigidly extends to exactly that motion."""
+    rng = np.random.default_rng(3)
+    odo = np.cumsum(rng.normal(0, 0.1, (40, 3)), axis=0)
+    t = np.arange(40) * 0.1 + 5.0
+    keep = np.array([0, 7, 8, 20, 39])
+    moved = compose([1.0, -2.0, 0.7], odo)
+    out = extend_by_odometry(t[keep], moved[keep], t, odo)
+    np.testing.assert_allclose(out, moved, atol=1e-12)
+    # a kept pose that is off carries its error to the scans after it, until the next one
+    off = moved[keep].copy()
+    off[1, 0] += 0.5
+    err = np.hypot(*(extend_by_odometry(t[keep], off, t, odo) - moved)[:, :2].T)
+    assert np.all(err[7] == pytest.approx(0.5)) and np.all(err[:7] < 1e-12)
+    assert np.all(err[8:] < 1e-12)
+
+
+@pytest.mark.parametrize(
+    "keep",
+    [[1, 5], [0, 5, 5], [0, 3, 2], [], [0, 40]],
+    ids=["not-from-the-first", "repeated", "not-increasing", "empty", "beyond-the-log"],
+)
+def test_extend_by_odometry_refuses_a_trajectory_not_of_the_log(keep):
+    odo = np.zeros((40, 3))
+    t = np.arange(40) * 0.1
+    ts = np.array([t[k] if k < 40 else 99.0 for k in keep])
+    with pytest.raises(ValueError, match="scan timestamps of the log"):
+        extend_by_odometry(ts, np.zeros((len(keep), 3)), t, odo)
+    with pytest.raises(ValueError, match="same lengths"):
+        extend_by_odometry(t[:3], np.zeros((2, 3)), t, odo)

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import itertools
 import json
 
 import numpy as np
@@ -794,6 +795,29 @@ def test_perturb_odometry_changes_the_last_bits_only(paper_log):
     for bad in (-1, 0.5, True):
         with pytest.raises(ValueError, match="seed"):
             perturb_odometry(paper_log, seed=bad)
+
+
+def test_sparsify_keeps_a_scan_per_metre_or_half_radian(paper_log):
+    """Each kept scan is the first whose odometry is 1 m or 0.5 rad from the last kept one's;
+    the scans between are dropped with everything they carry."""
+    from fhslam.sim import sparsify
+
+    out = sparsify(paper_log)
+    idx = kept_rows(paper_log, out)
+    assert idx[0] == 0 and 10 < len(out) < len(paper_log) / 5
+    odo = paper_log.odometry
+    for a, b in itertools.pairwise(idx):
+        step = np.hypot(*(odo[a + 1 : b + 1, :2] - odo[a, :2]).T)
+        turn = np.abs(wrap_angle(odo[a + 1 : b + 1, 2] - odo[a, 2]))
+        reached = (step >= 1.0) | (turn >= 0.5)
+        assert reached[-1] and not reached[:-1].any()
+    for field in ("timestamps", "ranges", "odometry", "truth", "hits"):
+        np.testing.assert_array_equal(getattr(out, field), getattr(paper_log, field)[idx])
+    assert len(sparsify(paper_log, distance=0.3)) > len(out)
+    assert len(sparsify(paper_log, distance=1e9, angle=1e9)) == 1
+    for bad in ({"distance": 0.0}, {"angle": -0.5}, {"distance": float("nan")}):
+        with pytest.raises(ValueError, match=r"distance|angle"):
+            sparsify(paper_log, **bad)
 
 
 # ------------------------------------------------------------------- how long a route is

@@ -24,6 +24,7 @@ from fhslam.metrics.detection import (
 from fhslam.metrics.map import as_segments, map_coverage, map_error, sample_segments
 from fhslam.metrics.relations import (
     RelationsError,
+    extend_by_odometry,
     relations_error,
     relations_errors,
     sample_relations,
@@ -53,6 +54,7 @@ __all__ = [
     "ate_errors",
     "detection_scores",
     "error_stats",
+    "extend_by_odometry",
     "line_difference",
     "map_coverage",
     "map_error",

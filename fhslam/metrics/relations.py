@@ -14,7 +14,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.spatial import cKDTree
 
-from fhslam.geometry import relative, wrap_angle
+from fhslam.geometry import compose, relative, wrap_angle
 from fhslam.metrics._arrays import _nearest, _poses, _stamps
 
 
@@ -267,3 +267,57 @@ def sample_relations(
             second.append(idx[b])
     i1, i2 = np.asarray(first), np.asarray(second)
     return ts[i1], ts[i2], relative(p[i1], p[i2])
+
+
+def extend_by_odometry(
+    timestamps: ArrayLike,
+    poses: ArrayLike,
+    all_timestamps: ArrayLike,
+    odometry: ArrayLike,
+) -> NDArray[np.float64]:
+    """A trajectory over some of a log's scans (a sparse copy's, :func:`fhslam.sim.sparsify`)
+    extended to every scan of the log by its odometry, so that it meets the log's relations.
+
+    Scan ``j`` gets the pose of the latest trajectory scan ``k`` at or before it, moved by
+    the odometry from ``k`` to ``j``: ``poses[k] ⊕ (⊖odometry[k] ⊕ odometry[j])``. What the
+    odometry adds between two kept scans (under a metre) is a floor of the relations error
+    the extended trajectory can reach.
+
+    Parameters
+    ----------
+    timestamps : array-like, shape (N,)
+        The trajectory's timestamps, increasing, each one of ``all_timestamps``.
+    poses : array-like, shape (N, 3)
+        Its poses (robot frame, as the odometry).
+    all_timestamps : array-like, shape (T,)
+        Every scan's timestamp, increasing; the first is the trajectory's first.
+    odometry : array-like, shape (T, 3)
+        The odometry pose at every scan.
+
+    Returns
+    -------
+    ndarray, shape (T, 3)
+
+    Raises
+    ------
+    ValueError
+        For shapes that do not match, or a trajectory timestamp that is not a scan's, or a
+        trajectory that does not start at the first scan.
+    """
+    ts, p = _stamps(timestamps, "timestamps"), _poses(poses, "poses")
+    every, odo = _stamps(all_timestamps, "all_timestamps"), _poses(odometry, "odometry")
+    if len(ts) != len(p) or len(every) != len(odo):
+        raise ValueError(
+            "timestamps and poses, all_timestamps and odometry must have the same lengths, "
+            f"got {len(ts)}, {len(p)}, {len(every)} and {len(odo)}"
+        )
+    idx = np.minimum(np.searchsorted(every, ts), max(len(every) - 1, 0))
+    if not (len(ts) and np.array_equal(every[idx], ts) and idx[0] == 0) or np.any(
+        np.diff(idx) <= 0
+    ):
+        raise ValueError(
+            "the trajectory's timestamps must be increasing scan timestamps of the log, "
+            "starting at its first scan"
+        )
+    k = np.searchsorted(idx, np.arange(len(every)), side="right") - 1
+    return compose(p[k], relative(odo[idx[k]], odo))

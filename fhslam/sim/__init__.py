@@ -1,9 +1,9 @@
 """Simulation: polygonal worlds, a ray-casting laser, drifting odometry, `simulate()`,
-`degrade()` (dropped scans, clutter returns, range noise) and `perturb_odometry()` (the last
-bit) for any log, and the ground truth the metrics score against (true lines of a scan, wall
-points the laser hit)."""
+`degrade()` (dropped scans, clutter returns, range noise), `perturb_odometry()` (the last
+bit) and `sparsify()` (one scan per metre or half radian) for any log, and the ground truth
+the metrics score against (true lines of a scan, wall points the laser hit)."""
 
-from fhslam.sim.degrade import degrade, perturb_odometry
+from fhslam.sim.degrade import degrade, perturb_odometry, sparsify
 from fhslam.sim.laser import LaserParams, add_range_noise, beam_angles, cast_rays
 from fhslam.sim.odometry import OdometryNoise, odometry_from_truth
 from fhslam.sim.simulate import MotionParams, follow_route, is_closed_route, lap_route, simulate
@@ -57,6 +57,7 @@ __all__ = [
     "ring_world",
     "route_clearance",
     "simulate",
+    "sparsify",
     "transform_world",
     "true_lines",
     "visible_wall_points",

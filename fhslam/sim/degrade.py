@@ -1,5 +1,6 @@
 """Degrade a log as a harsher world would: lost laser messages, clutter returns, range noise;
-and perturb its odometry in the last bit, as another CPU would.
+perturb its odometry in the last bit, as another CPU would; thin it to one scan per metre
+or half radian, as published "corrected" logs are (:func:`sparsify`).
 
 :func:`degrade` and :func:`perturb_odometry` work on any :class:`~fhslam.io.log.Log`,
 simulated or read from a file; the ground truth and wall hits of a simulated log follow the
@@ -177,15 +178,20 @@ def degrade(
     keep = np.ones(t, dtype=bool)
     keep[order[:n_drop]] = False
 
-    # Everything else (the laser's mount, its source, the world) is the log's own.
+    return _select(log, keep, ranges, hits)
+
+
+def _select(log: Log, keep: np.ndarray, ranges: np.ndarray, hits: np.ndarray | None) -> Log:
+    """The scans ``keep`` of ``log`` with these ``ranges`` and ``hits``; everything else (the
+    laser's mount, its source, the world) is the log's own."""
     return replace(
         log,
         timestamps=log.timestamps[keep].copy(),
-        ranges=ranges[keep],
+        ranges=ranges[keep].copy(),
         angles=log.angles.copy(),
         odometry=log.odometry[keep].copy(),
         truth=None if log.truth is None else log.truth[keep].copy(),
-        hits=None if hits is None else hits[keep],
+        hits=None if hits is None else hits[keep].copy(),
         angle_offsets=None if log.angle_offsets is None else log.angle_offsets[keep].copy(),
     )
 
@@ -213,3 +219,32 @@ def perturb_odometry(log: Log, seed: int, relative: float = LAST_BIT) -> Log:
     seed = _check_seed(seed)
     eps = np.random.default_rng(seed).standard_normal(log.odometry.shape)
     return replace(log, odometry=log.odometry * (1 + rel * eps))
+
+
+def sparsify(log: Log, distance: float = 1.0, angle: float = 0.5) -> Log:
+    """A copy of ``log`` that keeps a scan only when the odometry has moved ``distance``
+    metres or turned ``angle`` radians since the last scan kept, as many published
+    "corrected" logs are thinned (the first scan is always kept).
+
+    The odometry of the scans kept is the log's own: the motion between two kept scans is
+    the odometry integrated over the scans dropped between them.
+
+    Raises
+    ------
+    ValueError
+        If ``distance`` or ``angle`` is not a finite number > 0.
+    """
+    d = _check_non_negative("distance", distance, " of metres")
+    a = _check_non_negative("angle", angle, " of radians")
+    if d == 0 or a == 0:
+        raise ValueError(f"distance and angle must be > 0, got {distance!r} and {angle!r}")
+    odo = log.odometry
+    keep = np.zeros(len(odo), dtype=bool)
+    last = None
+    for i, pose in enumerate(odo):
+        if last is not None:
+            turn = abs(np.angle(np.exp(1j * (pose[2] - last[2]))))
+            if np.hypot(pose[0] - last[0], pose[1] - last[1]) < d and turn < a:
+                continue
+        keep[i], last = True, pose
+    return _select(log, keep, log.ranges, log.hits)

@@ -31,7 +31,8 @@ __all__ = ["GraphFastHoughSLAM", "scan_cloud"]
 # Fixed by the method (measured; not a parameter):
 MAX_DOUBTFUL = 5
 """A scan the tracker is not sure of starts no keyframe and adds no points, unless this many
-in a row were doubtful (new ground)."""
+in a row were doubtful, or the doubtful scans in a row span ``keyframes.distance`` of
+odometry (new ground: a sparse log moves a metre between two scans)."""
 
 
 def scan_cloud(points: NDArray[np.float64]) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
@@ -111,6 +112,7 @@ class GraphFastHoughSLAM(LoopClosing, GlobalSearch):
         self._path: list[float] = []  # distance travelled at each keyframe
         self._last_loop_path = 0.0
         self._doubtful = 0  # doubtful scans in a row
+        self._doubt_path = 0.0  # the odometry's path over them, metres
         self._pending: list[HeldClosure] = []
         self._failed: dict[int, int] = {}  # candidate -> the last keyframe it failed for
         self._hypothesis: tuple | None = None  # a global match waiting for another's support
@@ -138,6 +140,7 @@ class GraphFastHoughSLAM(LoopClosing, GlobalSearch):
         odometry = as_pose(odometry, "odometry")
         pts = None if scan is None else scan.points(max_range=p.keyframes.max_range)[0]
         track = None
+        moved = 0.0
         if self._pose is None:
             # Everything inside runs in the first pose's frame, so that where the world frame
             # lies changes nothing but the final composition (grids and voxels are aligned
@@ -146,6 +149,7 @@ class GraphFastHoughSLAM(LoopClosing, GlobalSearch):
             pose = np.zeros(3)
         else:
             step = relative(self._last_odometry, odometry)
+            moved = float(np.hypot(step[0], step[1]))
             self._kf_glitch = self._kf_glitch or bool(
                 np.hypot(step[0], step[1]) > MAX_STEP or abs(np.degrees(step[2])) > MAX_TURN_DEG
             )
@@ -159,10 +163,10 @@ class GraphFastHoughSLAM(LoopClosing, GlobalSearch):
         # A doubtful scan starts no keyframe and adds no points, unless doubt lasts.
         sure = track is None or track.sure
         self._doubtful = 0 if sure else self._doubtful + 1
+        self._doubt_path = 0.0 if sure else self._doubt_path + moved
+        lasting = self._doubtful >= MAX_DOUBTFUL or self._doubt_path >= p.keyframes.distance
         self._kf_doubt = self._kf_doubt or not sure
-        new = not self._kf_front or (
-            (sure or self._doubtful >= MAX_DOUBTFUL) and self._keyframe_due(pose)
-        )
+        new = not self._kf_front or ((sure or lasting) and self._keyframe_due(pose))
         if new:
             if scan is not None:
                 all_points = scan.points()[0]

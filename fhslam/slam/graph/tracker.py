@@ -7,13 +7,13 @@ point-to-line refinement (:func:`fhslam.scanmatch.refine`) from its optimum, whi
 millimetres and says how well each direction is constrained.
 
 Real odometry glitches: a heading jump of 30-85° between two scans (MIT CSAIL, Intel), a
-position jump of most of a metre. When the match at the prediction scores below
-``min_score``, or the odometry increment is larger than a robot moves between two scans,
-a second search around the previous pose (the robot stood still) with a wide window
-competes with it; the better score wins. When neither matches, the odometry prediction is
-kept: the fallback. After a doubtful scan the next one searches widely again, centred on
-the prediction when the odometry increment is plausible (on the previous pose only after a
-glitch).
+position jump of most of a metre. When the match at the prediction is not sure, or after a
+doubtful scan, a second search with a wide window runs around the prediction. When the
+odometry increment is larger than a robot moves between two scans at a laser's rate (a
+glitch, or a sparse log's metre), a third one runs around the previous pose (the robot
+stood still); it wins only by a clear margin (``STILL_MARGIN``: a metre along a corridor
+looks like standing still). When nothing matches, the odometry prediction is kept: the
+fallback.
 
 Turning fast into space the local map has not seen (a 5 Hz laser turning 50° between two
 scans), a scan scores low against the map although nothing is wrong. When the map gives no
@@ -66,6 +66,12 @@ MAX_STEP = 0.4
 """An odometry increment longer than this (metres)..."""
 MAX_TURN_DEG = 25.0
 """... or turning more than this (degrees) is a glitch: the recovery search runs."""
+STILL_PRIOR = (0.05, 0.05)
+"""The search around the previous pose after a glitch gives up this much score per metre and
+per radian: the odometry's increment says nothing then..."""
+STILL_MARGIN = 0.05
+"""... and it must score this much better than the best match around the prediction to win
+(a sparse log's metre along a corridor looks like standing still)."""
 QUERY_VOXEL = 0.05
 """The scan is thinned to one point per cell of this size (metres)..."""
 MAX_POINTS = 250
@@ -174,6 +180,22 @@ class ScanTracker:
         self._grid = LikelihoodGrid.build(pts, p.resolution, SIGMA, margin)
         self._points = PointMap.build(points, normals)
 
+    def _wide_search(
+        self, grid: LikelihoodGrid, q: NDArray[np.float64], centre: NDArray[np.float64], still: bool
+    ) -> tuple[float, NDArray[np.float64]]:
+        """The recovery search around ``centre``; ``still``: the previous pose (after a
+        glitch), with the weaker prior."""
+        p = self.params
+        return correlative_search(
+            grid,
+            q,
+            centre,
+            p.recovery_window,
+            np.radians(p.recovery_window_deg),
+            np.radians(ANGLE_STEP_DEG),
+            STILL_PRIOR if still else SEARCH_PRIOR,
+        )
+
     def track(
         self,
         points: NDArray[np.float64],
@@ -205,17 +227,13 @@ class ScanTracker:
         doubt, self._doubt = self._doubt, True
         glitch = np.hypot(*step) > MAX_STEP or turn > MAX_TURN_DEG
         if doubt or score < p.sure_score or glitch:
-            s2, pose2 = correlative_search(
-                self._grid,
-                q,
-                as_pose(previous, "previous") if glitch else predicted,
-                p.recovery_window,
-                np.radians(p.recovery_window_deg),
-                da,
-                (0.05, 0.05) if glitch else SEARCH_PRIOR,
-            )
-            if s2 > score + 0.02:
-                score, pose, recovered = s2, pose2, glitch
+            # Widely around the prediction; after a glitch also around the previous pose (the
+            # robot stood still), which must score clearly better to win.
+            for still in (False, True) if glitch else (False,):
+                centre = as_pose(previous, "previous") if still else predicted
+                s2, pose2 = self._wide_search(self._grid, q, centre, still)
+                if s2 > score + (STILL_MARGIN if still else 0.02):
+                    score, pose, recovered = s2, pose2, still
         target = self._points
         if score < p.sure_score and last is not None and len(last) >= 10:
             # Turning fast into space the map has not seen: the previous scan has seen it.
@@ -229,15 +247,7 @@ class ScanTracker:
                 SIGMA,
                 p.recovery_window + 3 * SIGMA,
             )
-            s3, pose3 = correlative_search(
-                grid,
-                q,
-                centre if glitch else predicted,
-                p.recovery_window,
-                np.radians(p.recovery_window_deg),
-                da,
-                (0.05, 0.05) if glitch else SEARCH_PRIOR,
-            )
+            s3, pose3 = self._wide_search(grid, q, centre if glitch else predicted, glitch)
             if s3 >= p.sure_score and s3 > score:
                 score, pose, recovered = s3, pose3, glitch
                 target = PointMap.build(cloud, normals)

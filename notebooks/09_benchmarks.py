@@ -264,6 +264,25 @@ for world in worlds:
     )
 
 # %% [markdown]
+# Many published logs are thinned to one scan per metre or half radian of odometry. A sparse
+# copy of each log (`fhslam.sim.sparsify`) puts every method there: a metre between two
+# scans is a glitch at a laser's rate, and the map of a few such scans covers little of the
+# next. The trajectory over the kept scans is extended to every scan by the odometry
+# (`fhslam.metrics.extend_by_odometry`) and scored on the log's relations; what the odometry
+# adds in between is a floor of a few centimetres (4-16 cm for the full run's poses so
+# extended).
+#
+# *Data:* `fhslam benchmark --out notebooks/results/`
+
+# %%
+# NBVAL_CHECK_OUTPUT
+sparse = {(r.name, r.method): r.error_m for r in draws if r.kind == "sparse"}
+print(f"{'sparse copy of':20} {'graph':>8} {'fht':>8} {'odometry':>9}   graph / odometry")
+for name in dict.fromkeys(n for n, _ in sparse):
+    g, f, o = (sparse[(name, m)] for m in ("graph", "fht", "odometry"))
+    print(f"{LABELS.get(name, name):20} {g:8.3f} {f:8.2f} {o:9.2f}   {g / o:8.3f}")
+
+# %% [markdown]
 # ## 3 · Run time against real time
 #
 # Each run of section 1 was timed alone, one after the other in one process (the draws above

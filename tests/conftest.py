@@ -170,6 +170,7 @@ SLOW_TESTS = {  # each over a second or so on 2 cores (pytest --durations)
     "test_special_outputs.py::test_a_non_ascii_name_under_the_c_locale_is_written",
     "test_special_outputs.py::test_simulate_writes_the_truth_to_standard_output",
     "test_tracker.py::test_an_odometry_glitch_is_absorbed",
+    "test_tracker.py::test_a_sparse_copy_is_tracked",
     "test_workbook.py::test_a_rerun_that_changes_nothing_leaves_the_notebook_as_it_was",
 }
 """Single tests of the slow tier (``module::name``, parameters included)."""

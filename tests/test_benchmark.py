@@ -102,6 +102,21 @@ def test_the_committed_draws_start_from_the_runs_as_read():
 STOP_OR_ISSUE = re.compile(r"\b(stop|issue)s? [0-9]+", re.IGNORECASE)
 
 
+def test_the_committed_sparse_copies_are_what_test_real_logs_measures():
+    """Every benchmark log's sparse copy run by each method, and the default's errors the
+    ones tests/test_real_logs.py's SPARSE states were measured, to 1 mm."""
+    from test_real_logs import SPARSE
+
+    draws = [r for r in load_draws(RESULTS / "robustness.csv") if r.kind == "sparse"]
+    assert {(r.name, r.method) for r in draws} == {
+        (n, m) for n in BENCHMARK_LOGS for m in ("graph", "fht", "odometry")
+    }
+    by = {(r.name, r.method): r.error_m for r in draws}
+    for name, (graph, fht, odometry) in SPARSE.items():
+        assert by[(name, "graph")] == pytest.approx(graph, abs=0.001), name
+        assert by[(name, "odometry")] == pytest.approx(odometry, rel=1e-3), name
+
+
 def test_the_tried_table_names_a_commit_per_idea():
     with open(RESULTS / "tried.csv", encoding="utf-8", newline="") as f:
         reader = csv.reader(f)
@@ -179,6 +194,8 @@ def test_an_unknown_log_is_refused_before_any_run(tmp_path):
         run_benchmark(tmp_path / "out", logs=["mit-killian"], progress=False)
     with pytest.raises(InputError, match=r"draws.logs: unknown benchmark log 'intel2'"):
         run_benchmark(tmp_path / "out", draws=Draws(logs=("intel2",)), progress=False)
+    with pytest.raises(InputError, match=r"draws.sparse_logs: unknown benchmark log 'x'"):
+        run_benchmark(tmp_path / "out", draws=Draws(sparse_logs=("x",)), progress=False)
     with pytest.raises(InputError, match="not the string 'intel'"):
         run_benchmark(tmp_path / "out", logs="intel", progress=False)
     with pytest.raises(ValueError, match="unknown SLAM methods"):

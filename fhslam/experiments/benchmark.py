@@ -6,13 +6,15 @@ procedure (``fht``) and odometry run one after the other in this process, each t
 and measured as ``fhslam evaluate TRAJ --relations NAME`` measures the trajectory file that
 ``fhslam slam --trajectory`` writes (:func:`measure_run`). Then, in parallel, the default runs
 over :class:`Draws`: logs degraded by range noise or dropped scans or with their odometry
-perturbed in the last bit (the runs of ``fhslam sweep --log``), and a simulated world likewise
-(``fhslam sweep --world``). The files written into ``out``:
+perturbed in the last bit (the runs of ``fhslam sweep --log``), a simulated world likewise
+(``fhslam sweep --world``), and every method on a sparse copy of each log (one scan per metre
+or half radian, :func:`fhslam.sim.sparsify`). The files written into ``out``:
 
 - ``benchmark.csv``: one :class:`BenchmarkRow` per log and method, the published numbers
   (:data:`PUBLISHED`) as rows of the method ``cartographer``;
 - ``table.md``: the README's results table of those rows (:func:`results_table`);
-- ``robustness.csv``: one :class:`DrawRow` per run over draws, for box plots;
+- ``robustness.csv``: one :class:`DrawRow` per run over draws, for box plots, and per sparse
+  copy and method;
 - per log and SLAM method its trajectory ``{log}_{method}.txt`` and map
   ``{log}_{method}_map.json``, for ``graph`` its keyframe graph ``{log}_graph_graph.json``:
   byte for byte what ``fhslam slam LOG --method M --trajectory ... --map ... --graph ...``
@@ -97,7 +99,8 @@ class Draws:
     may do). On each world of ``worlds``: ``world_seeds`` simulated logs at the odometry
     noise ``world_level``, clean and with both the range noise and the dropped scans
     (degraded with seed 0), each also with ``last_bit_draws`` perturbed odometries (the
-    runs of ``fhslam sweep --world``).
+    runs of ``fhslam sweep --world``). On each log of ``sparse_logs``: every method of
+    :data:`METHODS` on its sparse copy (:func:`sparse_error`).
     """
 
     logs: tuple[str, ...] = ("intel", "aces", "mit-csail", "fr079", "fr-clinic")
@@ -108,6 +111,7 @@ class Draws:
     worlds: tuple[str, ...] = ("paper",)
     world_seeds: int = 8
     world_level: str = "medium"
+    sparse_logs: tuple[str, ...] = BENCHMARK_LOGS
 
     def __post_init__(self) -> None:
         from fhslam.experiments.compare import noise_levels
@@ -124,6 +128,7 @@ class Draws:
             )
         object.__setattr__(self, "logs", tuple(self.logs))
         object.__setattr__(self, "worlds", tuple(self.worlds))
+        object.__setattr__(self, "sparse_logs", tuple(self.sparse_logs))
 
 
 DRAWS = Draws()
@@ -133,7 +138,7 @@ QUICK_LOGS = ("mit-csail",)
 """The logs of ``run_benchmark(..., quick=True)``: the shortest benchmark log (7 minutes of
 log, seconds to run)."""
 
-QUICK_DRAWS = Draws(logs=(), seeds=0, last_bit_draws=1, world_seeds=1)
+QUICK_DRAWS = Draws(logs=(), seeds=0, last_bit_draws=1, world_seeds=1, sparse_logs=())
 """The draws of ``run_benchmark(..., quick=True)``: one paper-world log, clean and degraded,
 each with one last-bit draw (seconds)."""
 
@@ -187,9 +192,10 @@ BENCHMARK_FIELDS = tuple(f.name for f in fields(BenchmarkRow))
 class DrawRow:
     """One run of the default SLAM over draws (a row of ``robustness.csv``).
 
-    ``kind`` is ``"log"`` (``error_m``: the mean translational relation error) or
-    ``"world"`` (``error_m``: the ATE RMSE against the simulated truth, at odometry noise
-    ``level``, simulated with ``seed``). ``degrade_seed`` is -1 for a log as read or a world
+    ``kind`` is ``"log"`` (``error_m``: the mean translational relation error), ``"world"``
+    (``error_m``: the ATE RMSE against the simulated truth, at odometry noise ``level``,
+    simulated with ``seed``) or ``"sparse"`` (a log's sparse copy, any ``method``:
+    :func:`sparse_error`). ``degrade_seed`` is -1 for a log as read or a world
     as simulated; ``last_bit`` 0 for the odometry as read. ``variant`` says it in words.
     """
 
@@ -472,6 +478,47 @@ def _world_draws(draws: Draws, n_jobs: int, progress: bool) -> list[DrawRow]:
     return rows
 
 
+SPARSE_VARIANT = "one scan per metre or half radian"
+"""The ``variant`` of a sparse copy's :class:`DrawRow`."""
+
+
+def sparse_error(log: Log, relations, method: str) -> float:
+    """``method`` on the sparse copy of ``log`` (:func:`fhslam.sim.sparsify`, defaults), its
+    trajectory extended to every scan of ``log`` by the odometry
+    (:func:`fhslam.metrics.extend_by_odometry`) and measured against ``relations`` (``(t1,
+    t2, rel)``): the mean translational relation error, metres."""
+    from fhslam.experiments.compare import _thread_lock_for_tqdm
+    from fhslam.metrics import extend_by_odometry, relations_error
+    from fhslam.pipeline import run_slam
+    from fhslam.sim import sparsify
+
+    _thread_lock_for_tqdm()
+    r = run_slam(sparsify(log), method)
+    poses = extend_by_odometry(r.timestamps, r.poses, log.timestamps, log.odometry)
+    return relations_error(log.timestamps, poses, *relations).trans_mean
+
+
+def _sparse_draws(draws: Draws, logs: dict[str, Log], n_jobs: int, progress: bool) -> list[DrawRow]:
+    """Every method on the sparse copy of each of ``draws.sparse_logs``, in parallel."""
+    from joblib import Parallel, delayed
+
+    from fhslam.experiments.compare import _workers_deaf_to_ctrl_c
+
+    jobs = [(n, m) for n in draws.sparse_logs for m in METHODS]
+    if not jobs:
+        return []
+    relations = {n: read_relations(find_dataset(n, "relations")) for n in draws.sparse_logs}
+    par = Parallel(n_jobs=n_jobs, return_as="generator")
+    with _workers_deaf_to_ctrl_c():
+        runs = par(delayed(sparse_error)(logs[n], relations[n], m) for n, m in jobs)
+        bar = tqdm(runs, total=len(jobs), desc="sparse copies", unit="run", disable=not progress)
+        errors = list(bar)
+    return [
+        DrawRow("sparse", n, m, SPARSE_VARIANT, "", -1, 0.0, 0.0, -1, 0, e)
+        for (n, m), e in zip(jobs, errors, strict=True)
+    ]
+
+
 def run_benchmark(
     out: str | os.PathLike[str],
     *,
@@ -530,7 +577,11 @@ def run_benchmark(
     if not methods:
         raise ValueError("methods: no SLAM method given")
     check_runs(methods, None, 0)
-    draw_logs = _check_logs(draws.logs, "draws.logs") if draws is not None else ()
+    draw_logs = (
+        _check_logs(draws.logs, "draws.logs") + _check_logs(draws.sparse_logs, "draws.sparse_logs")
+        if draws is not None
+        else ()
+    )
     with output_folder(out, str(out)) as folder:
         for name in dict.fromkeys(names + draw_logs):  # a DatasetNotFoundError if missing
             find_dataset(name, "log")
@@ -564,6 +615,7 @@ def run_benchmark(
                 as_read = {r.log: r.error_m for r in rows if r.method == "graph"}
                 found = _log_draws(draws, loaded, as_read, n_jobs, progress)
                 found += _world_draws(draws, n_jobs, progress)
+                found += _sparse_draws(draws, loaded, n_jobs, progress)
             # every file of the runs but the odometry's trajectory (made again in a moment)
             staged = [p for p in sorted(Path(tmp).iterdir()) if "_odometry" not in p.name]
             all_rows = _merged(kept, rows)
@@ -576,6 +628,7 @@ def run_benchmark(
                     f.write(results_table(all_rows))
                 if draws is not None:
                     redone = {("log", n) for n in draws.logs} | {("world", w) for w in draws.worlds}
+                    redone |= {("sparse", n) for n in draws.sparse_logs}
                     left = [r for r in kept_draws if (r.kind, r.name) not in redone]
                     _write_rows(draws_path, DRAW_FIELDS, left + found)
     return all_rows

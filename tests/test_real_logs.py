@@ -272,7 +272,7 @@ SPARSE = {
 @functools.cache
 def _sparse_error(name, method):
     from fhslam.datasets import find_dataset, load_log
-    from fhslam.experiments.benchmark import sparse_error
+    from fhslam.experiments.draw_runs import sparse_error
     from fhslam.io import read_relations
 
     return sparse_error(load_log(name), read_relations(find_dataset(name, "relations")), method)

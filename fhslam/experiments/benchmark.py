@@ -42,7 +42,7 @@ from tqdm.auto import tqdm
 
 from fhslam.datasets import DATASETS, find_dataset, load_log
 from fhslam.errors import InputError, MissingInputError
-from fhslam.io import Log, read_relations, write_graph, write_map, write_trajectory
+from fhslam.io import Log, write_graph, write_map, write_trajectory
 from fhslam.io.files import atomic_output, output_batch, output_folder, reading
 
 BENCHMARK_LOGS = ("intel", "aces", "mit-csail", "fr079", "fr-clinic", "fr101", "mit-killian-full")
@@ -100,7 +100,7 @@ class Draws:
     noise ``world_level``, clean and with both the range noise and the dropped scans
     (degraded with seed 0), each also with ``last_bit_draws`` perturbed odometries (the
     runs of ``fhslam sweep --world``). On each log of ``sparse_logs``: every method of
-    :data:`METHODS` on its sparse copy (:func:`sparse_error`).
+    :data:`METHODS` on its sparse copy (:func:`fhslam.experiments.draw_runs.sparse_error`).
     """
 
     logs: tuple[str, ...] = ("intel", "aces", "mit-csail", "fr079", "fr-clinic")
@@ -195,7 +195,7 @@ class DrawRow:
     ``kind`` is ``"log"`` (``error_m``: the mean translational relation error), ``"world"``
     (``error_m``: the ATE RMSE against the simulated truth, at odometry noise ``level``,
     simulated with ``seed``) or ``"sparse"`` (a log's sparse copy, any ``method``:
-    :func:`sparse_error`). ``degrade_seed`` is -1 for a log as read or a world
+    . ``degrade_seed`` is -1 for a log as read or a world
     as simulated; ``last_bit`` 0 for the odometry as read. ``variant`` says it in words.
     """
 
@@ -214,28 +214,6 @@ class DrawRow:
 
 DRAW_FIELDS = tuple(f.name for f in fields(DrawRow))
 """The columns of ``robustness.csv``, in order."""
-
-
-def _draw_row(kind, name, run, level, seed, error) -> DrawRow:
-    """A :class:`DrawRow` of ``run`` (a :class:`~fhslam.experiments.robustness.LogRun` or a
-    :class:`~fhslam.experiments.compare.RunResult`: degraded with its ``degrade_seed``, or
-    not at all)."""
-    done = [f"{1000 * run.range_noise:g} mm range noise"] if run.range_noise else []
-    done += [f"{100 * run.drop_fraction:g} % dropped"] if run.drop_fraction else []
-    variant = ", ".join(done) or ("as read" if kind == "log" else "as simulated")
-    return DrawRow(
-        kind=kind,
-        name=name,
-        method=run.method,
-        variant=f"{variant}, last bit" if run.last_bit else variant,
-        level=level,
-        seed=seed,
-        range_noise=run.range_noise,
-        drop_fraction=run.drop_fraction,
-        degrade_seed=run.degrade_seed if done else -1,
-        last_bit=run.last_bit,
-        error_m=error,
-    )
 
 
 # ------------------------------------------------------------------------------ files
@@ -424,101 +402,6 @@ def _published_rows(logs: Iterable[str]) -> list[BenchmarkRow]:
     ]
 
 
-def _log_draws(
-    draws: Draws, logs: dict[str, Log], as_read: dict[str, float], n_jobs: int, progress: bool
-) -> list[DrawRow]:
-    """The log draws of ``draws`` in parallel (the runs of ``fhslam sweep --log``); the run as
-    read only for a log whose ``graph`` run is not in ``as_read`` (log -> error)."""
-    from joblib import Parallel, delayed
-
-    from fhslam.experiments.compare import _workers_deaf_to_ctrl_c
-    from fhslam.experiments.robustness import _one
-
-    none = {"range_noise": 0.0, "drop_fraction": 0.0, "clutter_fraction": 0.0}
-    noise = {**none, "range_noise": draws.range_noise}
-    drop = {**none, "drop_fraction": draws.drop_fraction}
-    jobs = []
-    for name in draws.logs:
-        if name not in as_read:
-            jobs.append((name, none, -1, 0))
-        jobs += [(name, noise, s, 0) for s in range(draws.seeds) if draws.range_noise]
-        jobs += [(name, drop, s, 0) for s in range(draws.seeds) if draws.drop_fraction]
-        jobs += [(name, none, -1, b) for b in range(1, draws.last_bit_draws + 1)]
-    rows: dict[str, list[DrawRow]] = {
-        name: [DrawRow("log", name, "graph", "as read", "", -1, 0.0, 0.0, -1, 0, as_read[name])]
-        if name in as_read
-        else []
-        for name in draws.logs
-    }
-    if jobs:
-        relations = {n: read_relations(find_dataset(n, "relations")) for n in draws.logs}
-        par = Parallel(n_jobs=n_jobs, return_as="generator")
-        with _workers_deaf_to_ctrl_c():
-            runs = par(
-                delayed(_one)(logs[n], n, relations[n], "graph", None, deg, s, b)
-                for n, deg, s, b in jobs
-            )
-        bar = tqdm(runs, total=len(jobs), desc="log draws", unit="run", disable=not progress)
-        for r in bar:  # in the order of the jobs
-            rows[r.log].append(_draw_row("log", r.log, r, "", -1, r.trans_error))
-    return [r for name in draws.logs for r in rows[name]]
-
-
-def _world_draws(draws: Draws, n_jobs: int, progress: bool) -> list[DrawRow]:
-    """The world draws of ``draws`` (the runs of ``fhslam sweep --world``)."""
-    from fhslam.experiments.compare import slam_sweep
-
-    rows = []
-    for world in draws.worlds:
-        for noise, drop in ((0.0, 0.0), (draws.range_noise, draws.drop_fraction)):
-            runs = slam_sweep(world, range(draws.world_seeds), (draws.world_level,), ("graph",),
-                              n_jobs, progress, range_noise=noise, drop_fraction=drop,
-                              last_bit_draws=draws.last_bit_draws)  # fmt: skip
-            rows += [_draw_row("world", world, r, r.level, r.seed, r.ate_rmse) for r in runs]
-    return rows
-
-
-SPARSE_VARIANT = "one scan per metre or half radian"
-"""The ``variant`` of a sparse copy's :class:`DrawRow`."""
-
-
-def sparse_error(log: Log, relations, method: str) -> float:
-    """``method`` on the sparse copy of ``log`` (:func:`fhslam.sim.sparsify`, defaults), its
-    trajectory extended to every scan of ``log`` by the odometry
-    (:func:`fhslam.metrics.extend_by_odometry`) and measured against ``relations`` (``(t1,
-    t2, rel)``): the mean translational relation error, metres."""
-    from fhslam.experiments.compare import _thread_lock_for_tqdm
-    from fhslam.metrics import extend_by_odometry, relations_error
-    from fhslam.pipeline import run_slam
-    from fhslam.sim import sparsify
-
-    _thread_lock_for_tqdm()
-    r = run_slam(sparsify(log), method)
-    poses = extend_by_odometry(r.timestamps, r.poses, log.timestamps, log.odometry)
-    return relations_error(log.timestamps, poses, *relations).trans_mean
-
-
-def _sparse_draws(draws: Draws, logs: dict[str, Log], n_jobs: int, progress: bool) -> list[DrawRow]:
-    """Every method on the sparse copy of each of ``draws.sparse_logs``, in parallel."""
-    from joblib import Parallel, delayed
-
-    from fhslam.experiments.compare import _workers_deaf_to_ctrl_c
-
-    jobs = [(n, m) for n in draws.sparse_logs for m in METHODS]
-    if not jobs:
-        return []
-    relations = {n: read_relations(find_dataset(n, "relations")) for n in draws.sparse_logs}
-    par = Parallel(n_jobs=n_jobs, return_as="generator")
-    with _workers_deaf_to_ctrl_c():
-        runs = par(delayed(sparse_error)(logs[n], relations[n], m) for n, m in jobs)
-        bar = tqdm(runs, total=len(jobs), desc="sparse copies", unit="run", disable=not progress)
-        errors = list(bar)
-    return [
-        DrawRow("sparse", n, m, SPARSE_VARIANT, "", -1, 0.0, 0.0, -1, 0, e)
-        for (n, m), e in zip(jobs, errors, strict=True)
-    ]
-
-
 def run_benchmark(
     out: str | os.PathLike[str],
     *,
@@ -612,10 +495,12 @@ def run_benchmark(
                     bar.update(len(loaded[name]))
             found = []
             if draws is not None:
+                from fhslam.experiments.draw_runs import log_draws, sparse_draws, world_draws
+
                 as_read = {r.log: r.error_m for r in rows if r.method == "graph"}
-                found = _log_draws(draws, loaded, as_read, n_jobs, progress)
-                found += _world_draws(draws, n_jobs, progress)
-                found += _sparse_draws(draws, loaded, n_jobs, progress)
+                found = log_draws(draws, loaded, as_read, n_jobs, progress)
+                found += world_draws(draws, n_jobs, progress)
+                found += sparse_draws(draws, loaded, n_jobs, progress)
             # every file of the runs but the odometry's trajectory (made again in a moment)
             staged = [p for p in sorted(Path(tmp).iterdir()) if "_odometry" not in p.name]
             all_rows = _merged(kept, rows)

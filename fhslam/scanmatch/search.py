@@ -305,8 +305,9 @@ class MatchResult:
     guess_score: float = 0.0
     """The coarse grid's score at the guess (0 without a coarse stage)."""
     runner_up: float = 0.0
-    """The best coarse score more than ``exclude[0]`` metres from the coarse optimum if it is
-    more than ``exclude[1]`` times the coarse score, else 0 (0 unless :func:`match_clouds`
+    """The fine score of the best place more than ``exclude[0]`` metres from the coarse
+    optimum (found on the coarse grid above ``exclude[1]`` times its score) if it is more
+    than ``exclude[1]`` times the match's fine score, else 0 (0 unless :func:`match_clouds`
     was asked for it)."""
 
 
@@ -382,10 +383,12 @@ def match_clouds(
         apart (along a corridor), the guess wins instead of the window's corner.
     exclude : (float, float), optional
         ``(radius, fraction)``: also look for the best coarse score more than ``radius``
-        metres (in x or y) from the coarse optimum, above ``fraction`` of the coarse score
-        (:attr:`MatchResult.runner_up`): a match is unique only if nothing elsewhere scores
-        nearly as well (a corridor with doors every few metres). Branch and bound looks only
-        where that is possible, so an answer of "none" is cheap.
+        metres (in x or y) from the coarse optimum, above ``fraction`` of the coarse score,
+        and score it on the fine grid (:attr:`MatchResult.runner_up`): a match is unique
+        only if nothing elsewhere scores nearly as well (a corridor with doors every few
+        metres); the coarse grid's blur alone would hide what tells two places apart.
+        Branch and bound looks only where that is possible, so an answer of "none" is
+        cheap.
     min_coarse : float
         The coarse stage looks only for poses scoring (less the prior) above this: if there
         is none, the result has scores 0 and the guess as its pose, and the fine stage does
@@ -428,22 +431,35 @@ def match_clouds(
             rival = (grid, qc, g, search)
         g = best
 
+    qf = _thin(voxel_downsample(q, 1.5 * rf), max_points[1])
+    fw = 6 * rf
+
+    def fine_stage(centre) -> tuple[float, NDArray[np.float64]]:
+        near = _crop(tg, q, centre, fw + 3 * sf)
+        if len(near) < 10:
+            return 0.0, centre
+        grid = LikelihoodGrid.build(near, rf, sf, fw + 3 * sf)
+        return correlative_search(
+            grid, qf, centre, fw, np.radians(ac if window > 0 else window_deg), np.radians(af),
+            prior,
+        )  # fmt: skip
+
     def runner_up(score: float) -> float:
-        """The runner-up's coarse score, looked for once the match is worth it."""
+        """The runner-up's score, looked for once the match is worth it: found on the coarse
+        grid, scored on the fine one (the coarse grid's blur hides what tells two places
+        apart: a hall's pillars)."""
         if rival is None or not score >= exclude_min_score:
             return 0.0
         grid_c, points, guess_c, search_c = rival
-        return correlative_search(
+        s_r, at = correlative_search(
             grid_c, points, guess_c, *search_c, exclude=(best, exclude[0]), floor=exclude[1] * s_c
-        )[0]
+        )
+        if s_r <= 0:
+            return 0.0
+        s_rf = fine_stage(at)[0]
+        return s_rf if s_rf > exclude[1] * score else 0.0
 
-    qf = _thin(voxel_downsample(q, 1.5 * rf), max_points[1])
-    fw = 6 * rf
-    near = _crop(tg, q, g, fw + 3 * sf)
-    if len(near) < 10:
+    s_f, pose = fine_stage(g)
+    if s_f == 0.0:
         return MatchResult(g, 0.0, s_c, s_g, runner_up(0.0))
-    grid = LikelihoodGrid.build(near, rf, sf, fw + 3 * sf)
-    s_f, pose = correlative_search(
-        grid, qf, g, fw, np.radians(ac if window > 0 else window_deg), np.radians(af), prior
-    )
     return MatchResult(pose, s_f, s_c, s_g, runner_up(s_f))

@@ -271,8 +271,8 @@ graph_summary(graph, res_graph)
 # | Cartographer | 0.0229 ± 0.0239 | Hess et al. 2016, Table II |
 #
 # The paper's procedure reduces the odometry's 7.4 m to 2.8 m but stays at metres: globally it is
-# not a usable map. The graph method brings Intel to 0.014 ± 0.011 m and 0.22°, with 692 loop
-# closures, all but one still active in the end (the run switches off any it finds inconsistent
+# not a usable map. The graph method brings Intel to 0.014 ± 0.010 m and 0.22°, with 715 loop
+# closures, all still active in the end (the run switches off any it finds inconsistent
 # after optimising). That is below the published graph-mapping and Cartographer numbers — but read it
 # with two caveats: Intel is a *development* log, the defaults were developed on it; and the
 # published numbers come from other implementations on other machines.
@@ -460,7 +460,7 @@ span_summary(rows_intel, t1, t2, rel)
 # is no better in translation than this robot's odometry (0.033 m); what it adds locally is a
 # better heading (right panel). The scan-to-map tracker is better at every span: about 1 cm below
 # 5 s. Over minutes the paper's procedure drifts to metres (6.8 m beyond 60 s), while the graph
-# stays at 0.016 m.
+# stays at 0.017 m.
 
 # %% [markdown]
 # ## Exercise 8.3 (interpret) — local accuracy, global consistency
@@ -591,8 +591,8 @@ span_summary(res_mit, t1_mit, t2_mit, rel_mit)
 # %% [markdown]
 # The graph method brings mit-csail, with the same defaults as Intel, to 0.027 ± 0.022 m and 0.34°
 # over all relations, against 0.77 m for the paper's procedure and 1.68 m for the raw odometry —
-# 0.025 m below 5 s (0.044 m for the paper's procedure), 0.042 m between 5 s and a minute (2.1 m;
-# only 27 relations) and 0.040 m over more than a minute (7.9 m). All 242 of its accepted loop
+# 0.025 m below 5 s (0.044 m for the paper's procedure), 0.041 m between 5 s and a minute (2.1 m;
+# only 27 relations) and 0.040 m over more than a minute (7.9 m). All 247 of its accepted loop
 # closures stay active (none is switched off as inconsistent). The run took 10.8 s on this machine, about
 # 39× faster than real time (the table below). This log is where the method was least robust: before
 # closures that move a keyframe far had to wait for an independent one, a relative change of 1e-15

@@ -396,7 +396,9 @@ print(f"{len(tried)} ideas tried and not adopted, from {len({t['commit'] for t i
 #   odometry stay at decimetres to metres; section 1 gives it beside Cartographer's published
 #   numbers log by log.
 # - A single run is one draw: section 2 shows how far range noise, dropped scans and the
-#   odometry's last bit move each result, against the bound the tests hold the default to.
+#   odometry's last bit move each result, against the bound the tests hold the default to;
+#   on sparse copies (one scan per metre) it stays within a thirteenth of the odometry's
+#   error on six of the seven logs, and the hospital's is worse than its odometry.
 # - Run times are of one machine on one day: read them with the load they were taken under.
 # - Ideas that were measured and left out stay findable: each row of section 5 names its
 #   commit.

@@ -593,8 +593,8 @@ span_summary(res_mit, t1_mit, t2_mit, rel_mit)
 # over all relations, against 0.77 m for the paper's procedure and 1.68 m for the raw odometry —
 # 0.025 m below 5 s (0.044 m for the paper's procedure), 0.041 m between 5 s and a minute (2.1 m;
 # only 27 relations) and 0.040 m over more than a minute (7.9 m). All 247 of its accepted loop
-# closures stay active (none is switched off as inconsistent). The run took 10.8 s on this machine, about
-# 39× faster than real time (the table below). This log is where the method was least robust: before
+# closures stay active (none is switched off as inconsistent). How long the run took, and how many
+# times faster than real time, is in the table below. This log is where the method was least robust: before
 # closures that move a keyframe far had to wait for an independent one, a relative change of 1e-15
 # in the odometry could decide a few loop closures differently and cost decimetres;
 # `tests/test_real_logs.py` checks that such last-bit noise changes its error by under 1 mm.

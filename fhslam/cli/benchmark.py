@@ -30,7 +30,8 @@ def add_parser(sub) -> argparse.ArgumentParser:
         "--logs",
         nargs="+",
         metavar="NAME",
-        help="dataset names (default: every benchmark log); the other logs' rows are kept",
+        help="only these dataset names (default: every benchmark log): their runs and draws; "
+        "the other logs' rows and the worlds' are kept",
     )
     p.add_argument(
         "--quick",
@@ -39,6 +40,13 @@ def add_parser(sub) -> argparse.ArgumentParser:
         "last-bit draw each): minutes instead of 15-30 on 2 cores",
     )
     p.add_argument("--no-draws", action="store_true", help="no runs over draws")
+    p.add_argument(
+        "--draw-seed",
+        type=int,
+        metavar="SEED",
+        help="the seed the draws' seeds come from (default: a fresh one, printed first; give "
+        "it to repeat a benchmark's draws)",
+    )
     p.add_argument("--jobs", type=int, default=-1, help="worker processes for the draws")
     p.add_argument("--scheduler", metavar="ADDRESS", help=SCHEDULER_HELP + " (the draws)")
     p.add_argument("--quiet", action="store_true", help="no progress bars")
@@ -48,17 +56,31 @@ def add_parser(sub) -> argparse.ArgumentParser:
 
 def run(args: argparse.Namespace) -> None:
     """Run the benchmark and print the results table."""
-    from fhslam.experiments.benchmark import results_table, run_benchmark
+    from dataclasses import replace
 
-    kwargs = {"draws": None} if args.no_draws else {}
+    from fhslam.experiments.benchmark import DRAWS, QUICK_DRAWS, results_table, run_benchmark
+
+    draws = None
+    if not args.no_draws:
+        draws = (QUICK_DRAWS if args.quick else DRAWS).seeded()
+        if args.draw_seed is not None:
+            draws = replace(draws, seed=args.draw_seed)
+        if args.logs:
+            draws = replace(
+                draws,
+                logs=tuple(n for n in args.logs if n in draws.logs),
+                sparse_logs=tuple(n for n in args.logs if n in draws.sparse_logs),
+                worlds=(),
+            )
+        print(f"draws: seed {draws.seed} (to repeat them: --draw-seed {draws.seed})", flush=True)
     with on_cluster(args.scheduler):
         rows = run_benchmark(
             args.out,
             logs=args.logs,
+            draws=draws,
             quick=args.quick,
             n_jobs=args.jobs,
             progress=not args.quiet,
-            **kwargs,
         )
     print(results_table(rows))
     print(f"wrote {args.out}")

@@ -34,7 +34,7 @@ import tempfile
 import time
 import warnings
 from collections.abc import Iterable, Sequence
-from dataclasses import astuple, dataclass, fields
+from dataclasses import astuple, dataclass, fields, replace
 from pathlib import Path
 
 import numpy as np
@@ -87,40 +87,75 @@ PUBLISHED_METHOD = "cartographer"
 """The method name of :data:`PUBLISHED`'s rows in ``benchmark.csv``."""
 
 
+DRAW_KINDS = (
+    "range noise",
+    "dropped",
+    "last bit",
+    "world",
+    "world range noise",
+    "world dropped",
+    "world last bit",
+    "frame",
+)
+"""What each stream of :meth:`Draws.seeds_of` draws seeds for (its index: the stream)."""
+
+
+def fresh_seed() -> int:
+    """A seed for :class:`Draws` nobody picked: drawn from the operating system's entropy."""
+    return int(np.random.SeedSequence().generate_state(1, np.uint32)[0])
+
+
 @dataclass(frozen=True)
 class Draws:
-    """The runs over draws of :func:`run_benchmark`, all of the default SLAM.
+    """The runs over draws of :func:`run_benchmark`, all of the default SLAM; their seeds
+    come from ``seed`` (:meth:`seeds_of`).
 
     On each log of ``logs``: ``seeds`` copies with ``range_noise`` metres of Gaussian noise on
-    every range and ``seeds`` copies with a ``drop_fraction`` share of the scans dropped
-    (:func:`fhslam.sim.degrade` with seeds ``0 .. seeds - 1``), and ``last_bit_draws`` runs
-    of the log as read with its odometry perturbed in the last bit
-    (:func:`fhslam.sim.perturb_odometry`, seeds ``1 .. last_bit_draws``: what another CPU
-    may do). On each world of ``worlds``: ``world_seeds`` simulated logs at the odometry
-    noise ``world_level``, clean and with both the range noise and the dropped scans
-    (degraded with seed 0), each also with ``last_bit_draws`` perturbed odometries (the
-    runs of ``fhslam sweep --world``). On each log of ``sparse_logs``: every method of
-    :data:`METHODS` on its sparse copy (:func:`fhslam.experiments.draw_runs.sparse_error`).
+    every range, ``seeds`` copies with a ``drop_fraction`` share of the scans dropped
+    (:func:`fhslam.sim.degrade`), and ``last_bit_draws`` runs of the log as read with its
+    odometry perturbed in the last bit (:func:`fhslam.sim.perturb_odometry`: what another CPU
+    may do). On each world of ``worlds``: ``world_seeds`` simulated logs at the odometry noise
+    ``world_level``, each run in ``frames`` frames (as given, then moved by a random rigid
+    motion: the method must not care where the world frame lies), and once each with the
+    range noise, with the dropped scans and (``last_bit_draws`` > 0) with a last-bit
+    perturbation. On each log of
+    ``sparse_logs``: every method of :data:`METHODS` on its sparse copy
+    (:func:`fhslam.experiments.draw_runs.sparse_error`).
+
+    ``seed`` None (the default) draws a fresh one (:func:`fresh_seed`) when the runs start:
+    results are judged by draws nobody picked. The seed of every run is in its
+    :class:`DrawRow`, so any one run can be repeated alone, and ``Draws(seed=S)`` repeats
+    them all.
     """
 
-    logs: tuple[str, ...] = ("intel", "aces", "mit-csail", "fr079", "fr-clinic")
-    seeds: int = 3
+    logs: tuple[str, ...] = BENCHMARK_LOGS
+    seeds: int = 8
     range_noise: float = 0.001
     drop_fraction: float = 0.1
-    last_bit_draws: int = 2
+    last_bit_draws: int = 8
     worlds: tuple[str, ...] = ("paper",)
     world_seeds: int = 8
     world_level: str = "medium"
+    frames: int = 4
     sparse_logs: tuple[str, ...] = BENCHMARK_LOGS
+    seed: int | None = None
 
     def __post_init__(self) -> None:
         from fhslam.experiments.compare import noise_levels
         from fhslam.sim.degrade import check_degradation
 
-        for name in ("seeds", "last_bit_draws", "world_seeds"):
+        for name in ("seeds", "last_bit_draws", "world_seeds", "frames"):
             n = getattr(self, name)
             if isinstance(n, bool) or not isinstance(n, int | np.integer) or n < 0:
                 raise ValueError(f"Draws.{name} must be a whole number >= 0, got {n!r}")
+        if self.frames < 1 and self.world_seeds and self.worlds:
+            raise ValueError("Draws.frames must be at least 1 (the world as given)")
+        if self.seed is not None and (
+            isinstance(self.seed, bool)
+            or not isinstance(self.seed, int | np.integer)
+            or self.seed < 0
+        ):
+            raise ValueError(f"Draws.seed must be a whole number >= 0 or None, got {self.seed!r}")
         check_degradation(self.drop_fraction, 0.0, 0, self.range_noise)
         if self.world_level not in noise_levels():
             raise ValueError(
@@ -130,6 +165,30 @@ class Draws:
         object.__setattr__(self, "worlds", tuple(self.worlds))
         object.__setattr__(self, "sparse_logs", tuple(self.sparse_logs))
 
+    def seeded(self) -> Draws:
+        """These draws with a seed: their own, or a fresh one."""
+        return self if self.seed is not None else replace(self, seed=fresh_seed())
+
+    def seeds_of(self, kind: str, n: int) -> list[int]:
+        """``n`` seeds (1 .. 2³¹ - 1; 0 means "none" to a last-bit draw) of the stream
+        ``kind`` (one of :data:`DRAW_KINDS`), drawn from :attr:`seed` (which must be set:
+        :meth:`seeded`). The streams are independent, and the first ``n`` of a stream do not
+        depend on ``n``."""
+        if self.seed is None:
+            raise ValueError("Draws.seed is None: call Draws.seeded() first")
+        state = np.random.SeedSequence([int(self.seed), DRAW_KINDS.index(kind)])
+        return [int(v) % (2**31 - 1) + 1 for v in state.generate_state(n, np.uint32)]
+
+    def motions(self) -> list[tuple[float, float, float]]:
+        """The frames' rigid motions ``(x, y, theta)``: none first, then ``frames - 1``
+        drawn from :attr:`seed` (x and y uniform in ± 10 m, theta in ± 180°)."""
+        rng = np.random.default_rng(self.seeds_of("frame", 1)[0])
+        moves = [(0.0, 0.0, 0.0)]
+        for _ in range(self.frames - 1):
+            x, y = rng.uniform(-10.0, 10.0, 2)
+            moves.append((float(x), float(y), float(rng.uniform(-np.pi, np.pi))))
+        return moves
+
 
 DRAWS = Draws()
 """The draws of a default :func:`run_benchmark`."""
@@ -138,9 +197,9 @@ QUICK_LOGS = ("mit-csail",)
 """The logs of ``run_benchmark(..., quick=True)``: the shortest benchmark log (7 minutes of
 log, seconds to run)."""
 
-QUICK_DRAWS = Draws(logs=(), seeds=0, last_bit_draws=1, world_seeds=1, sparse_logs=())
-"""The draws of ``run_benchmark(..., quick=True)``: one paper-world log, clean and degraded,
-each with one last-bit draw (seconds)."""
+QUICK_DRAWS = Draws(logs=(), seeds=0, last_bit_draws=1, world_seeds=1, frames=2, sparse_logs=())
+"""The draws of ``run_benchmark(..., quick=True)``: one paper-world log in two frames, with
+range noise, with dropped scans and with a last-bit perturbation (seconds)."""
 
 
 # ------------------------------------------------------------------------------ rows
@@ -424,7 +483,8 @@ def run_benchmark(
     methods : sequence of str
         SLAM methods (:data:`fhslam.pipeline.METHODS`) run on each log, one at a time.
     draws : Draws or None
-        The runs over draws (default :data:`DRAWS`; with ``quick``, :data:`QUICK_DRAWS`);
+        The runs over draws (default :data:`DRAWS`; with ``quick``, :data:`QUICK_DRAWS`),
+        with fresh seeds unless ``draws.seed`` is given (the rows hold every run's seed);
         ``None``: none, and an existing ``robustness.csv`` is left as it is.
     quick : bool
         A small subset (a minute, against 15-30 on 2 cores): the logs and draws not given
@@ -465,6 +525,8 @@ def run_benchmark(
         if draws is not None
         else ()
     )
+    if draws is not None:
+        draws = draws.seeded()
     with output_folder(out, str(out)) as folder:
         for name in dict.fromkeys(names + draw_logs):  # a DatasetNotFoundError if missing
             find_dataset(name, "log")

@@ -22,13 +22,21 @@ from pathlib import Path
 
 import numpy as np
 from joblib import Parallel, delayed
+from numpy.typing import ArrayLike
 from tqdm.auto import tqdm
 
 from fhslam.errors import InputError, InputWarning
 from fhslam.io.files import atomic_output
 from fhslam.metrics import ate, map_error
 from fhslam.pipeline import METHODS, run_slam
-from fhslam.sim import OdometryNoise, degrade, load_world, perturb_odometry, simulate
+from fhslam.sim import (
+    OdometryNoise,
+    degrade,
+    load_world,
+    perturb_odometry,
+    simulate,
+    transform_world,
+)
 from fhslam.sim.degrade import check_degradation
 
 
@@ -118,9 +126,12 @@ def one_run(
     degrade_seed: int = 0,
     last_bit: int = 0,
     params: object | None = None,
+    frame: ArrayLike | None = None,
 ) -> list[RunResult]:
     """Simulate ``world`` with noise ``level`` and ``seed``; run every method on that log
-    (the ``graph`` method with ``params``, default its defaults).
+    (the ``graph`` method with ``params``, default its defaults). With ``frame`` (a rigid
+    motion ``(x, y, theta)``) the world is moved by it first (:func:`fhslam.sim.transform_world`:
+    the same scans, the truth and odometry moved).
 
     The log is first degraded (:func:`fhslam.sim.degrade` with ``range_noise``,
     ``drop_fraction``, ``clutter_fraction`` and ``degrade_seed``) if any of those is not
@@ -131,6 +142,8 @@ def one_run(
     with warnings.catch_warnings():  # a world file's warnings: given once, before the sweep
         warnings.simplefilter("ignore", InputWarning)
         w = load_world(world)
+    if frame is not None:
+        w = transform_world(w, frame)
     log = simulate(w, seed=seed, odometry=noise_levels()[level])
     changed = {
         "range_noise": range_noise,

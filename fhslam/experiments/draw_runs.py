@@ -5,22 +5,31 @@ a sparse copy of a log (:func:`sparse_draws`)."""
 
 from __future__ import annotations
 
+import numpy as np
 from tqdm.auto import tqdm
 
 from fhslam.datasets import find_dataset
 from fhslam.experiments.benchmark import METHODS, DrawRow, Draws
 from fhslam.io import Log, read_relations
 
-__all__ = ["SPARSE_VARIANT", "log_draws", "sparse_draws", "sparse_error", "world_draws"]
+__all__ = [
+    "SPARSE_VARIANT",
+    "frame_text",
+    "log_draws",
+    "sparse_draws",
+    "sparse_error",
+    "world_draws",
+]
 
 
-def _draw_row(kind, name, run, level, seed, error) -> DrawRow:
+def _draw_row(kind, name, run, level, seed, error, moved="") -> DrawRow:
     """A :class:`DrawRow` of ``run`` (a :class:`~fhslam.experiments.robustness.LogRun` or a
     :class:`~fhslam.experiments.compare.RunResult`: degraded with its ``degrade_seed``, or
-    not at all)."""
+    not at all; ``moved``: the frame it ran in, in words, if not the world's own)."""
     done = [f"{1000 * run.range_noise:g} mm range noise"] if run.range_noise else []
     done += [f"{100 * run.drop_fraction:g} % dropped"] if run.drop_fraction else []
     variant = ", ".join(done) or ("as read" if kind == "log" else "as simulated")
+    variant += f", {moved}" if moved else ""
     return DrawRow(
         kind=kind,
         name=name,
@@ -36,11 +45,19 @@ def _draw_row(kind, name, run, level, seed, error) -> DrawRow:
     )
 
 
+def frame_text(motion) -> str:
+    """A frame's rigid motion in words, as a world :class:`DrawRow`'s ``variant`` names it:
+    ``"moved (3.14, -2.72) m, 57.3°"``."""
+    x, y, theta = motion
+    return f"moved ({x:.2f}, {y:.2f}) m, {np.degrees(theta):.1f}°"
+
+
 def log_draws(
     draws: Draws, logs: dict[str, Log], as_read: dict[str, float], n_jobs: int, progress: bool
 ) -> list[DrawRow]:
-    """The log draws of ``draws`` in parallel (the runs of ``fhslam sweep --log``); the run as
-    read only for a log whose ``graph`` run is not in ``as_read`` (log -> error)."""
+    """The log draws of ``draws`` (seeded: :meth:`Draws.seeded`) in parallel (the runs of
+    ``fhslam sweep --log``); the run as read only for a log whose ``graph`` run is not in
+    ``as_read`` (log -> error)."""
     from joblib import Parallel, delayed
 
     from fhslam.experiments.compare import _workers_deaf_to_ctrl_c
@@ -49,13 +66,15 @@ def log_draws(
     none = {"range_noise": 0.0, "drop_fraction": 0.0, "clutter_fraction": 0.0}
     noise = {**none, "range_noise": draws.range_noise}
     drop = {**none, "drop_fraction": draws.drop_fraction}
+    noise_seeds = draws.seeds_of("range noise", draws.seeds) if draws.range_noise else []
+    drop_seeds = draws.seeds_of("dropped", draws.seeds) if draws.drop_fraction else []
     jobs = []
     for name in draws.logs:
         if name not in as_read:
             jobs.append((name, none, -1, 0))
-        jobs += [(name, noise, s, 0) for s in range(draws.seeds) if draws.range_noise]
-        jobs += [(name, drop, s, 0) for s in range(draws.seeds) if draws.drop_fraction]
-        jobs += [(name, none, -1, b) for b in range(1, draws.last_bit_draws + 1)]
+        jobs += [(name, noise, s, 0) for s in noise_seeds]
+        jobs += [(name, drop, s, 0) for s in drop_seeds]
+        jobs += [(name, none, -1, b) for b in draws.seeds_of("last bit", draws.last_bit_draws)]
     rows: dict[str, list[DrawRow]] = {
         name: [DrawRow("log", name, "graph", "as read", "", -1, 0.0, 0.0, -1, 0, as_read[name])]
         if name in as_read
@@ -70,23 +89,52 @@ def log_draws(
                 delayed(_one)(logs[n], n, relations[n], "graph", None, deg, s, b)
                 for n, deg, s, b in jobs
             )
-        bar = tqdm(runs, total=len(jobs), desc="log draws", unit="run", disable=not progress)
-        for r in bar:  # in the order of the jobs
-            rows[r.log].append(_draw_row("log", r.log, r, "", -1, r.trans_error))
+            bar = tqdm(runs, total=len(jobs), desc="log draws", unit="run", disable=not progress)
+            for r in bar:  # in the order of the jobs
+                rows[r.log].append(_draw_row("log", r.log, r, "", -1, r.trans_error))
     return [r for name in draws.logs for r in rows[name]]
 
 
 def world_draws(draws: Draws, n_jobs: int, progress: bool) -> list[DrawRow]:
-    """The world draws of ``draws`` (the runs of ``fhslam sweep --world``)."""
-    from fhslam.experiments.compare import slam_sweep
+    """The world draws of ``draws`` (seeded: :meth:`Draws.seeded`), in parallel: each
+    simulated log in every frame of :meth:`Draws.motions`, and once each with range noise,
+    with dropped scans and with a last-bit perturbation (as given)."""
+    from joblib import Parallel, delayed
 
-    rows = []
+    from fhslam.experiments.compare import _workers_deaf_to_ctrl_c, one_run
+
+    n = draws.world_seeds
+    motions = draws.motions()
+    changes = [{"frame": m} for m in motions[1:]]
+    if draws.range_noise:
+        noise_seeds = draws.seeds_of("world range noise", n)
+        changes += [{"range_noise": draws.range_noise, "degrade_seed": noise_seeds}]
+    if draws.drop_fraction:
+        drop_seeds = draws.seeds_of("world dropped", n)
+        changes += [{"drop_fraction": draws.drop_fraction, "degrade_seed": drop_seeds}]
+    if draws.last_bit_draws:
+        changes += [{"last_bit": draws.seeds_of("world last bit", n)}]
+    jobs = []
     for world in draws.worlds:
-        for noise, drop in ((0.0, 0.0), (draws.range_noise, draws.drop_fraction)):
-            runs = slam_sweep(world, range(draws.world_seeds), (draws.world_level,), ("graph",),
-                              n_jobs, progress, range_noise=noise, drop_fraction=drop,
-                              last_bit_draws=draws.last_bit_draws)  # fmt: skip
-            rows += [_draw_row("world", world, r, r.level, r.seed, r.ate_rmse) for r in runs]
+        for k, seed in enumerate(draws.seeds_of("world", n)):
+            jobs.append((world, seed, {}))
+            jobs += [
+                (world, seed, {c: v[k] if isinstance(v, list) else v for c, v in ch.items()})
+                for ch in changes
+            ]
+    if not jobs:
+        return []
+    par = Parallel(n_jobs=n_jobs, return_as="generator")
+    with _workers_deaf_to_ctrl_c():
+        runs = par(
+            delayed(one_run)(world, draws.world_level, seed, ("graph",), **kw)
+            for world, seed, kw in jobs
+        )
+        bar = tqdm(runs, total=len(jobs), desc="world draws", unit="run", disable=not progress)
+        rows = []
+        for (world, _, kw), (r,) in zip(jobs, bar, strict=True):
+            moved = frame_text(kw["frame"]) if "frame" in kw else ""
+            rows.append(_draw_row("world", world, r, r.level, r.seed, r.ate_rmse, moved))
     return rows
 
 

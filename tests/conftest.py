@@ -99,6 +99,7 @@ def blind_turn(log, degrees, before, blind, after):
 
 SLOW_MODULES = {
     "test_browser.py",  # JupyterLab in headless Chromium
+    "test_gaps.py",  # the default SLAM on worlds with scans missing in a row
     "test_golden.py",  # whole-log trajectories and maps pinned to the bit
     "test_graphslam.py",  # the default SLAM on simulated worlds, whole runs
     "test_real_logs.py",  # every real log with the default SLAM, and its degradations

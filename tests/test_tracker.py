@@ -12,7 +12,7 @@ from fhslam.metrics import ate
 from fhslam.pipeline import run_slam
 from fhslam.sim import OdometryNoise, load_world, simulate
 from fhslam.slam.graph import GraphFastHoughSLAM
-from fhslam.slam.graph.tracker import TrackerParams
+from fhslam.slam.graph.tracker import MAX_STEP, MAX_TURN_DEG, TrackerParams, is_glitch
 
 
 @pytest.fixture(scope="module")
@@ -27,6 +27,14 @@ def _glitch(log, k, extra):
     a = compose(odo[k - 1], compose(np.asarray(extra, float), inverse(odo[k - 1])))
     odo[k:] = compose(a, odo[k:])
     return replace(log, odometry=odo)
+
+
+def test_a_glitch_is_a_step_or_a_turn_past_its_limit_either_way():
+    """One predicate for the tracker and the keyframes: past ``MAX_STEP`` metres or
+    ``MAX_TURN_DEG`` degrees, left or right; at the limit, not yet."""
+    assert not is_glitch(MAX_STEP, MAX_TURN_DEG) and not is_glitch(0.0, -MAX_TURN_DEG)
+    assert is_glitch(MAX_STEP + 1e-9, 0.0) and is_glitch(0.0, -MAX_TURN_DEG - 1e-9)
+    assert is_glitch(1.0, 30.0) and not is_glitch(0.05, 2.0)
 
 
 @pytest.mark.parametrize(

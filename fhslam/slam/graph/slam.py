@@ -23,7 +23,7 @@ from fhslam.slam.fht import SlamParams
 from fhslam.slam.graph.closure import HeldClosure, LoopClosing, LoopClosure
 from fhslam.slam.graph.params import GraphSlamParams
 from fhslam.slam.graph.search import GlobalSearch
-from fhslam.slam.graph.tracker import MAX_STEP, MAX_TURN_DEG, ScanTracker
+from fhslam.slam.graph.tracker import ScanTracker, is_glitch
 from fhslam.slam.graph.worker import InOrder, LoopTargetCache
 
 __all__ = ["GraphFastHoughSLAM", "scan_cloud"]
@@ -150,9 +150,7 @@ class GraphFastHoughSLAM(LoopClosing, GlobalSearch):
         else:
             step = relative(self._last_odometry, odometry)
             moved = float(np.hypot(step[0], step[1]))
-            self._kf_glitch = self._kf_glitch or bool(
-                np.hypot(step[0], step[1]) > MAX_STEP or abs(np.degrees(step[2])) > MAX_TURN_DEG
-            )
+            self._kf_glitch = self._kf_glitch or is_glitch(moved, np.degrees(step[2]))
             predicted = compose(self._pose, step)
             pose = predicted
             if pts is not None and len(pts) >= 10:

@@ -49,7 +49,7 @@ from fhslam.scanmatch import (
     voxel_downsample,
 )
 
-__all__ = ["ScanTracker", "Track", "TrackerParams"]
+__all__ = ["ScanTracker", "Track", "TrackerParams", "is_glitch"]
 
 
 # Fixed by the method (measured; not parameters):
@@ -66,6 +66,15 @@ MAX_STEP = 0.4
 """An odometry increment longer than this (metres)..."""
 MAX_TURN_DEG = 25.0
 """... or turning more than this (degrees) is a glitch: the recovery search runs."""
+
+
+def is_glitch(distance: float, turn_deg: float) -> bool:
+    """Whether an odometry increment of ``distance`` metres turning ``turn_deg`` degrees is
+    a glitch (longer than ``MAX_STEP`` or turning more than ``MAX_TURN_DEG``): more than a
+    robot moves between two scans at a laser's rate (a glitch, or a sparse log's metre)."""
+    return bool(distance > MAX_STEP or abs(turn_deg) > MAX_TURN_DEG)
+
+
 STILL_PRIOR = (0.05, 0.05)
 """The search around the previous pose after a glitch gives up this much score per metre and
 per radian: the odometry's increment says nothing then..."""
@@ -225,7 +234,7 @@ class ScanTracker:
         )
         recovered = False
         doubt, self._doubt = self._doubt, True
-        glitch = np.hypot(*step) > MAX_STEP or turn > MAX_TURN_DEG
+        glitch = is_glitch(np.hypot(*step), turn)
         if doubt or score < p.sure_score or glitch:
             # Widely around the prediction; after a glitch also around the previous pose (the
             # robot stood still), which must score clearly better to win.

@@ -147,30 +147,43 @@ def sparse_error(log: Log, relations, method: str) -> float:
     trajectory extended to every scan of ``log`` by the odometry
     (:func:`fhslam.metrics.extend_by_odometry`) and measured against ``relations`` (``(t1,
     t2, rel)``): the mean translational relation error, metres."""
+    from fhslam.sim import sparsify
+
+    return _sparse_run(sparsify(log), log.timestamps, log.odometry, relations, method)
+
+
+def _sparse_run(sparse: Log, timestamps, odometry, relations, method: str) -> float:
+    """:func:`sparse_error` of a sparse copy made already: what a worker is sent (the full
+    log's ``timestamps`` and ``odometry``, not its scans)."""
     from fhslam.experiments.compare import _thread_lock_for_tqdm
     from fhslam.metrics import extend_by_odometry, relations_error
     from fhslam.pipeline import run_slam
-    from fhslam.sim import sparsify
 
     _thread_lock_for_tqdm()
-    r = run_slam(sparsify(log), method)
-    poses = extend_by_odometry(r.timestamps, r.poses, log.timestamps, log.odometry)
-    return relations_error(log.timestamps, poses, *relations).trans_mean
+    r = run_slam(sparse, method)
+    poses = extend_by_odometry(r.timestamps, r.poses, timestamps, odometry)
+    return relations_error(timestamps, poses, *relations).trans_mean
 
 
 def sparse_draws(draws: Draws, logs: dict[str, Log], n_jobs: int, progress: bool) -> list[DrawRow]:
-    """Every method on the sparse copy of each of ``draws.sparse_logs``, in parallel."""
+    """Every method on the sparse copy of each of ``draws.sparse_logs``, in parallel (each
+    log thinned once, here)."""
     from joblib import Parallel, delayed
 
     from fhslam.experiments.compare import _workers_deaf_to_ctrl_c
+    from fhslam.sim import sparsify
 
     jobs = [(n, m) for n in draws.sparse_logs for m in METHODS]
     if not jobs:
         return []
     relations = {n: read_relations(find_dataset(n, "relations")) for n in draws.sparse_logs}
+    sparse = {n: sparsify(logs[n]) for n in draws.sparse_logs}
     par = Parallel(n_jobs=n_jobs, return_as="generator")
     with _workers_deaf_to_ctrl_c():
-        runs = par(delayed(sparse_error)(logs[n], relations[n], m) for n, m in jobs)
+        runs = par(
+            delayed(_sparse_run)(sparse[n], logs[n].timestamps, logs[n].odometry, relations[n], m)
+            for n, m in jobs
+        )
         bar = tqdm(runs, total=len(jobs), desc="sparse copies", unit="run", disable=not progress)
         errors = list(bar)
     return [

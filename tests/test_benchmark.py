@@ -26,6 +26,7 @@ from fhslam.errors import InputError
 from fhslam.experiments.benchmark import (
     BENCHMARK_LOGS,
     PUBLISHED,
+    QUICK_DRAWS,
     BenchmarkRow,
     Draws,
     load_benchmark,
@@ -33,6 +34,7 @@ from fhslam.experiments.benchmark import (
     results_table,
     run_benchmark,
 )
+from fhslam.experiments.draw_runs import frame_text
 
 ROOT = Path(__file__).resolve().parents[1]
 RESULTS = ROOT / "notebooks" / "results"
@@ -79,24 +81,39 @@ def test_the_committed_benchmark_has_every_log_and_method():
             assert (RESULTS / name).is_file(), name
 
 
-def test_the_committed_draws_start_from_the_runs_as_read():
-    """Every log over draws has its run as read, which is the benchmark's graph run."""
+def test_the_committed_draws_are_the_default_matrix_from_the_runs_as_read():
+    """Every benchmark log over draws: its run as read (the benchmark's graph run) and eight
+    draws of each kind, each with a seed of its own; every world log in four frames and once
+    with each degradation."""
     rows = {(r.log, r.method): r for r in load_benchmark(RESULTS / "benchmark.csv")}
     draws = load_draws(RESULTS / "robustness.csv")
-    logs = {r.name for r in draws if r.kind == "log"}
-    assert logs, "no log draws"
-    for name in logs:
+    assert {r.name for r in draws if r.kind == "log"} == set(BENCHMARK_LOGS)
+    for name in BENCHMARK_LOGS:
         sel = [r for r in draws if r.kind == "log" and r.name == name]
         (as_read,) = [r for r in sel if r.variant == "as read"]
         assert as_read.error_m == rows[(name, "graph")].error_m
-        assert {r.variant for r in sel} == {
-            "as read",
-            "1 mm range noise",
-            "10 % dropped",
-            "as read, last bit",
-        }
-    assert any(r.kind == "world" for r in draws)
+        for variant in ("1 mm range noise", "10 % dropped", "as read, last bit"):
+            seeds = [r.degrade_seed if r.degrade_seed >= 0 else r.last_bit
+                     for r in sel if r.variant == variant]  # fmt: skip
+            assert len(seeds) == len(set(seeds)) == 8 and min(seeds) > 0, (name, variant)
+    world = [r for r in draws if r.kind == "world"]
+    seeds = {r.seed for r in world}
+    assert len(seeds) == 8 and {r.name for r in world} == {"paper"}
+    for seed in seeds:
+        variants = [r.variant for r in world if r.seed == seed]
+        assert len(variants) == 7 and sum(", moved (" in v for v in variants) == 3, variants
     assert all(math.isfinite(r.error_m) and r.error_m > 0 for r in draws)
+
+
+def test_a_world_moved_gives_the_same_error_in_every_committed_draw():
+    """Four frames of each of eight fresh world logs: a rigid motion of the world frame
+    changes the ATE by rounding only (under a micrometre)."""
+    world = [r for r in load_draws(RESULTS / "robustness.csv") if r.kind == "world"]
+    given = {r.seed: r.error_m for r in world if r.variant == "as simulated"}
+    moved = [r for r in world if ", moved (" in r.variant]
+    assert len(moved) == 24
+    for r in moved:
+        assert r.error_m == pytest.approx(given[r.seed], abs=1e-6), r
 
 
 STOP_OR_ISSUE = re.compile(r"\b(stop|issue)s? [0-9]+", re.IGNORECASE)
@@ -228,11 +245,51 @@ def test_an_out_that_is_a_file_is_refused_before_any_run(tmp_path):
         ({"last_bit_draws": 1.5}, r"Draws.last_bit_draws must be a whole number"),
         ({"drop_fraction": 1.5}, "drop_fraction"),
         ({"world_level": "extreme"}, r"Draws.world_level must be one of"),
+        ({"frames": -1}, r"Draws.frames must be a whole number >= 0, got -1"),
+        ({"frames": 0}, r"Draws.frames must be at least 1 \(the world as given\)"),
+        ({"seed": -3}, r"Draws.seed must be a whole number >= 0 or None, got -3"),
+        ({"seed": 2.5}, r"Draws.seed must be a whole number >= 0 or None, got 2.5"),
+        ({"seed": True}, r"Draws.seed must be a whole number >= 0 or None, got True"),
     ],
 )
 def test_bad_draws_are_refused_when_made(change, message):
     with pytest.raises(ValueError, match=message):
         Draws(**change)
+
+
+def test_the_draws_seeds_come_from_one_seed_fresh_unless_given():
+    a, b = Draws().seeded(), Draws().seeded()
+    assert Draws().seed is None and a.seed != b.seed  # drawn anew (equal: one in 2**32)
+    d = Draws(seed=7)
+    assert d.seeded() is d
+    eight = d.seeds_of("range noise", 8)
+    assert len(set(eight)) == 8 and all(1 <= s < 2**31 for s in eight)
+    assert d.seeds_of("range noise", 3) == eight[:3]  # the first do not depend on how many
+    assert Draws(seed=7, seeds=2).seeds_of("range noise", 8) == eight  # nor on the counts
+    assert d.seeds_of("dropped", 8) != eight and Draws(seed=8).seeds_of("range noise", 8) != eight
+    with pytest.raises(ValueError, match=r"Draws.seed is None: call Draws.seeded\(\) first"):
+        Draws().seeds_of("last bit", 1)
+    with pytest.raises(ValueError, match=r"unknown kind of draw 'noise'; one of \['range noise'"):
+        d.seeds_of("noise", 1)
+    moves = d.motions()
+    assert len(set(moves)) == 4 and moves[0] == (0.0, 0.0, 0.0)
+    assert all(abs(x) <= 10 and abs(y) <= 10 and abs(t) <= math.pi for x, y, t in moves)
+    assert Draws(seed=7, frames=2).motions() == moves[:2]
+    assert frame_text((1.234, -5.0, math.pi / 2)) == "moved (1.23, -5.00) m, 90.0°"
+
+
+def test_the_command_prints_the_draws_seed_and_takes_it_back(tmp_path, capsys):
+    from fhslam.cli import main
+
+    assert main(["benchmark", "--out", str(tmp_path / "o"), "--logs", "nope", "--quiet",
+                 "--draw-seed", "5"]) == 2  # fmt: skip
+    assert capsys.readouterr().out == "draws: seed 5 (to repeat them: --draw-seed 5)\n"
+    assert main(["benchmark", "--out", str(tmp_path / "o"), "--logs", "nope", "--quiet"]) == 2
+    seed = re.fullmatch(r"draws: seed (\d+) \(to repeat them: --draw-seed \1\)\n",
+                        capsys.readouterr().out)  # fmt: skip
+    assert seed is not None
+    assert main(["benchmark", "--out", str(tmp_path / "o"), "--logs", "nope", "--no-draws"]) == 2
+    assert capsys.readouterr().out == ""
 
 
 # ---------------------------------------------------------------- a small subset, run again
@@ -256,8 +313,12 @@ def quick_run(tmp_path_factory):
     out = tmp_path_factory.mktemp("benchmark")
     for name in ("benchmark.csv", "robustness.csv"):  # rows of other runs are kept
         shutil.copy(RESULTS / name, out / name)
-    rows = run_benchmark(out, quick=True, methods=("graph",), progress=False)
+    rows = run_benchmark(out, quick=True, methods=("graph",), draws=QUICK, progress=False)
     return out, rows
+
+
+QUICK = replace(QUICK_DRAWS, seed=11)
+"""The quick draws of the tests, seeded (the command draws a fresh seed)."""
 
 
 def test_a_rerun_of_the_shortest_log_gives_the_committed_row(quick_run):
@@ -293,10 +354,19 @@ def test_a_rerun_draws_the_world_again_and_keeps_the_log_draws(quick_run):
     now = load_draws(out / "robustness.csv")
     assert [r for r in now if r.kind == "log"] == [r for r in committed if r.kind == "log"]
     world = [r for r in now if r.kind == "world"]
-    assert {(r.seed, r.degrade_seed >= 0, r.last_bit) for r in world} == {
-        (0, False, 0),
-        (0, False, 1),
-        (0, True, 0),
-        (0, True, 1),
-    }
+    # one fresh log of the paper world: as given, moved, with range noise, with dropped
+    # scans, with a last-bit perturbation; each with its seed drawn from QUICK's
+    assert [r.variant for r in world] == [
+        "as simulated",
+        f"as simulated, {frame_text(QUICK.motions()[1])}",
+        "1 mm range noise",
+        "10 % dropped",
+        "as simulated, last bit",
+    ]
+    assert {r.seed for r in world} == set(QUICK.seeds_of("world", 1))
+    noise, drop = QUICK.seeds_of("world range noise", 1), QUICK.seeds_of("world dropped", 1)
+    assert [r.degrade_seed for r in world] == [-1, -1, *noise, *drop, -1]
+    assert [r.last_bit for r in world] == [0, 0, 0, 0, *QUICK.seeds_of("world last bit", 1)]
+    # a moved world frame changes nothing but rounding
+    assert world[1].error_m == pytest.approx(world[0].error_m, abs=1e-6)
     assert all(0 < r.error_m < 0.2 for r in world)

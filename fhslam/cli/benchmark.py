@@ -36,8 +36,8 @@ def add_parser(sub) -> argparse.ArgumentParser:
     p.add_argument(
         "--quick",
         action="store_true",
-        help="a small subset (MIT CSAIL; one seed of the paper world, clean and degraded, one "
-        "last-bit draw each): minutes instead of 15-30 on 2 cores",
+        help="a small subset (MIT CSAIL; one log of the paper world in two frames, with range "
+        "noise, dropped scans and a last-bit draw): minutes instead of an hour or more on 2 cores",
     )
     p.add_argument("--no-draws", action="store_true", help="no runs over draws")
     p.add_argument(

@@ -118,9 +118,11 @@ class Draws:
     ``world_level``, each run in ``frames`` frames (as given, then moved by a random rigid
     motion: the method must not care where the world frame lies), and once each with the
     range noise, with the dropped scans and (``last_bit_draws`` > 0) with a last-bit
-    perturbation. On each log of
-    ``sparse_logs``: every method of :data:`METHODS` on its sparse copy
-    (:func:`fhslam.experiments.draw_runs.sparse_error`).
+    perturbation. On each log of ``sparse_logs``: every method of :data:`METHODS` on its
+    sparse copy (:func:`fhslam.experiments.draw_runs.sparse_error`).
+
+    The default matrix is hundreds of whole-log runs (an hour or more on 2 cores): ``fhslam
+    benchmark --jobs`` or ``--scheduler`` spreads them.
 
     ``seed`` None (the default) draws a fresh one (:func:`fresh_seed`) when the runs start:
     results are judged by draws nobody picked. The seed of every run is in its
@@ -176,6 +178,8 @@ class Draws:
         depend on ``n``."""
         if self.seed is None:
             raise ValueError("Draws.seed is None: call Draws.seeded() first")
+        if kind not in DRAW_KINDS:
+            raise ValueError(f"unknown kind of draw {kind!r}; one of {list(DRAW_KINDS)}")
         state = np.random.SeedSequence([int(self.seed), DRAW_KINDS.index(kind)])
         return [int(v) % (2**31 - 1) + 1 for v in state.generate_state(n, np.uint32)]
 
@@ -487,7 +491,7 @@ def run_benchmark(
         with fresh seeds unless ``draws.seed`` is given (the rows hold every run's seed);
         ``None``: none, and an existing ``robustness.csv`` is left as it is.
     quick : bool
-        A small subset (a minute, against 15-30 on 2 cores): the logs and draws not given
+        A small subset (minutes, against an hour or more on 2 cores): the logs and draws not given
         default to :data:`QUICK_LOGS` and :data:`QUICK_DRAWS`.
     n_jobs : int
         Worker processes for the draws (joblib; -1: one per core). The runs of ``methods``
@@ -525,8 +529,7 @@ def run_benchmark(
         if draws is not None
         else ()
     )
-    if draws is not None:
-        draws = draws.seeded()
+    draws = None if draws is None else draws.seeded()
     with output_folder(out, str(out)) as folder:
         for name in dict.fromkeys(names + draw_logs):  # a DatasetNotFoundError if missing
             find_dataset(name, "log")

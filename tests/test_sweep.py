@@ -30,8 +30,8 @@ def runs():
 ATE_TOLERANCE = 5e-4
 """How far a run now may be from the committed file's, in ATE (m), for every method: the
 results hold to far below a millimetre on any machine (the graph method's too: its decisions
-do not flip with the last bit: two last-bit draws of each of 8 seeds of the paper world give
-its ATE to 1e-13 m, notebooks/results/robustness.csv)."""
+do not flip with the last bit: a last-bit draw of each of 8 logs of the paper world moves
+its ATE by less than 1e-13 m, notebooks/results/robustness.csv)."""
 
 
 def test_a_sweep_file_reads_back_exactly(runs, tmp_path):

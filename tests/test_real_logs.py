@@ -81,6 +81,13 @@ def test_the_hospitals_relations_under_a_minute_hold(real_data):
     assert e.trans_mean <= 0.105, f"{e.trans_mean:.4f} m"
 
 
+HOSPITAL_DRAWN = (
+    "two of the 24 draws of the benchmark seeded 3209647287 (fhslam benchmark --draw-seed "
+    "3209647287): the return to the start is missed, 0.449 m with the noise, 0.504 m with the "
+    "drops (the other 22: 0.115-0.135 m)"
+)
+
+
 def _clinic_error(params=None, **degraded) -> float:
     """The hospital's mean translational relation error (metres) of a run of the default
     SLAM (or ``params``) on the log degraded by ``degraded`` (:func:`fhslam.sim.degrade`)."""
@@ -99,8 +106,18 @@ def _clinic_error(params=None, **degraded) -> float:
         {"range_noise": 0.001, "seed": 0},
         {"drop_fraction": 0.1, "seed": 0},
         {"drop_fraction": 0.1, "seed": 3},
+        pytest.param(
+            {"range_noise": 0.001, "seed": 955905649},
+            marks=pytest.mark.xfail(strict=True, reason=HOSPITAL_DRAWN),
+            id="range-noise-drawn",
+        ),
+        pytest.param(
+            {"drop_fraction": 0.1, "seed": 219205979},
+            marks=pytest.mark.xfail(strict=True, reason=HOSPITAL_DRAWN),
+            id="dropped-scans-drawn",
+        ),
     ],
-    ids=["range-noise", "dropped-scans", "dropped-scans-seed-3"],
+    ids=["range-noise", "dropped-scans", "dropped-scans-seed-3", None, None],
 )
 def test_the_hospital_is_robust(real_data, degraded):
     """The robustness bound: 1 mm of Gaussian noise on every range, or 10 % of the scans

@@ -33,3 +33,15 @@ def test_the_default_slam_meets_the_limit_on_unseen_worlds_moved_noisy_and_dropp
     # the odometry alone is metres off: the SLAM has work to do
     assert ate(log.odometry, log.truth).rmse > 0.5
     assert ate(run_slam(log).poses, log.truth).rmse <= LIMIT_M
+
+
+@pytest.mark.xfail(strict=True, reason="3.98 cm (the paper's procedure 3.20 cm): the 2 cm limit")
+def test_a_paper_world_log_nobody_picked_meets_the_limit():
+    """Seed 209544132 of the paper world at the ``medium`` odometry noise, one of the eight
+    the benchmark seeded 3209647287 drew (``fhslam benchmark --draw-seed 3209647287``; three
+    of them end over 2 cm: 2.11, 2.26 and this one's 3.98 cm, in every frame alike)."""
+    from fhslam.experiments.compare import one_run
+
+    (graph,) = one_run("paper", "medium", 209544132, ("graph",))
+    assert graph.odometry_ate_rmse > 1.0  # the odometry drifts metres
+    assert graph.ate_rmse <= 0.02

@@ -248,9 +248,11 @@ for ax, world in zip(axes[0], worlds):
     labels = []
     for v in variants:  # a moved frame's label ends in its motion, on lines of its own
         head, _, motion = v.partition(", moved ")
-        tail = ",\nmoved " + motion.replace(" m, ", " m,\n") if motion else ""
+        tail = ",\nmoved\n" + motion.replace(" m, ", " m,\n") if motion else ""
         labels.append(head.replace(", ", ",\n") + tail)
     ax.set_xticks(range(1, len(variants) + 1), labels, fontsize=8)
+    ax.axhline(2.0, color="C3", lw=1, ls="--", label="the limit of a simulated world, 2 cm")
+    ax.legend(loc="upper right", fontsize=8)
     ax.set(ylabel="ATE RMSE [cm]", title=f"The default on the {world} world, {len(sel)} runs")
     ax.set_ylim(bottom=0)
 fig.tight_layout()

@@ -104,24 +104,23 @@ def world_draws(draws: Draws, n_jobs: int, progress: bool) -> list[DrawRow]:
     from fhslam.experiments.compare import _workers_deaf_to_ctrl_c, one_run
 
     n = draws.world_seeds
-    motions = draws.motions()
-    changes = [{"frame": m} for m in motions[1:]]
+    kws = [[{}] + [{"frame": m} for m in draws.motions()[1:]] for _ in range(n)]
     if draws.range_noise:
-        noise_seeds = draws.seeds_of("world range noise", n)
-        changes += [{"range_noise": draws.range_noise, "degrade_seed": noise_seeds}]
+        for kw, s in zip(kws, draws.seeds_of("world range noise", n), strict=True):
+            kw.append({"range_noise": draws.range_noise, "degrade_seed": s})
     if draws.drop_fraction:
-        drop_seeds = draws.seeds_of("world dropped", n)
-        changes += [{"drop_fraction": draws.drop_fraction, "degrade_seed": drop_seeds}]
+        for kw, s in zip(kws, draws.seeds_of("world dropped", n), strict=True):
+            kw.append({"drop_fraction": draws.drop_fraction, "degrade_seed": s})
     if draws.last_bit_draws:
-        changes += [{"last_bit": draws.seeds_of("world last bit", n)}]
-    jobs = []
-    for world in draws.worlds:
-        for k, seed in enumerate(draws.seeds_of("world", n)):
-            jobs.append((world, seed, {}))
-            jobs += [
-                (world, seed, {c: v[k] if isinstance(v, list) else v for c, v in ch.items()})
-                for ch in changes
-            ]
+        for kw, s in zip(kws, draws.seeds_of("world last bit", n), strict=True):
+            kw.append({"last_bit": s})
+    seeds = draws.seeds_of("world", n)
+    jobs = [
+        (world, seed, kw)
+        for world in draws.worlds
+        for seed, runs in zip(seeds, kws, strict=True)
+        for kw in runs
+    ]
     if not jobs:
         return []
     par = Parallel(n_jobs=n_jobs, return_as="generator")

@@ -15,13 +15,9 @@ than ``loops.window`` metres away scores over ``GLOBAL_MAX_AMBIGUITY`` of it) an
 point-to-line like a local closure; and then only as a hypothesis, until the match of a
 query that shares no keyframe with its own agrees with it (within ``GLOBAL_CONSISTENCY``
 metres and ``GLOBAL_CONSISTENCY_DEG`` degrees) scoring at least ``search.confirm_score``;
-both then enter the graph. That query is first the one just before the hypothesis's (its
-last ``search.keyframes`` keyframes end where the hypothesis's begin), asked at once: the
-robot may have come back through the place found as well as go on into it; then each of the
-next queries that share no keyframe with it. After a closure that ended ``L`` metres
-without one, the search goes on as if still ``L`` metres out for the next
-``GLOBAL_LOOKBACK × L`` metres: the old map around the place found may be bent, and the next
-old place may lie far off.
+both then enter the graph. After a closure that ended ``L`` metres without one, the search
+goes on as if still ``L`` metres out for the next ``GLOBAL_LOOKBACK × L`` metres: the old map
+around the place found may be bent, and the next old place may lie far off.
 
 The class here is a part of :class:`~fhslam.slam.GraphFastHoughSLAM` (a mixin).
 """
@@ -54,9 +50,8 @@ class GlobalSearch:
 
     def _search_globally(self, i: int, poses) -> bool:
         """The global search (see ``search.every``): a match is held as a hypothesis until a
-        match from a query that shares no keyframe with its own (the one just before it,
-        asked at once, then the next ones) agrees with it; then both enter the graph, it is
-        optimised, and True is returned."""
+        match from a query that shares no keyframe with its own agrees with it; then both
+        enter the graph, it is optimised, and True is returned."""
         p = self.params
         h = self._hypothesis
         if h is not None and i - h[1] > p.search.keyframes + p.search.every:
@@ -67,21 +62,15 @@ class GlobalSearch:
             return False  # the next query must share no keyframe with the hypothesis's
         self._last_global = i
         # a hypothesis is confirmed by a match that agrees with it at the lower score
-        confirm = min(p.search.min_score, p.search.confirm_score)
-        g = self._global_match(i, poses, p.search.min_score if h is None else confirm)
+        low = p.search.min_score if h is None else min(p.search.min_score, p.search.confirm_score)
+        g = self._global_match(i, poses, low)
         if g is None:
             return False
         tol = (GLOBAL_CONSISTENCY, GLOBAL_CONSISTENCY_DEG)
         if h is None or not self._agree(h, g, poses, tol):
-            if g[4] < p.search.min_score:
-                return False
-            # a new hypothesis: the query just before it, which shares no keyframe with it,
-            # may confirm it at once (the place found may lie behind as well as ahead)
-            back = i - p.search.keyframes
-            h = self._global_match(back, poses, confirm) if back >= 0 else None
-            if h is None or not self._agree(h, g, poses, tol):
+            if g[4] >= p.search.min_score:
                 self._hypothesis = g
-                return False
+            return False
         self._hypothesis = None
         closed = [self._add_loop(*x[:5]) for x in (h, g)]
         blind = self._path[i] - self._last_loop_path

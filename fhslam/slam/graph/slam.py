@@ -44,7 +44,6 @@ def scan_cloud(points: NDArray[np.float64]) -> tuple[NDArray[np.float64], NDArra
     that thinning to one point per voxel keeps them)."""
     normals = scan_normals(points)
     points = smooth_scan(points, normals)
-    normals = scan_normals(points)
     dense, dense_normals = densify(points, normals)
     first = np.argsort(np.isnan(dense_normals[:, 0]), kind="stable")
     return dense[first], dense_normals[first]

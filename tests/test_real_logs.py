@@ -65,6 +65,30 @@ def test_real_log_relations_error_meets_its_limit(real_data, name):
     assert e.trans_mean <= limit, f"{name}: {e.trans_mean:.4f} m (measured {measured} m)"
 
 
+# The two long logs, scored against pseudo ground truth (relations between the poses of a
+# reference SLAM run: a floor of a few centimetres): (the limit, measured), as REAL_LOGS.
+LONG_LOGS = {"fr101": (0.07, 0.0544), "mit-killian-full": (0.40, 0.3582)}
+
+
+@pytest.mark.parametrize("name", LONG_LOGS)
+def test_a_long_log_meets_its_limit(real_data, name):
+    """Freiburg 101 (gzipped CARMEN, 7 minutes) within 0.07 m; MIT Killian Court at full rate
+    (17,480 scans, 1.9 km) within 0.40 m, its measured 0.358 m and the draws' spread (0.33 to
+    0.62 m over 24 draws, ``fhslam benchmark``); its aim of 0.15 m is not met
+    (``test_killian_meets_the_aim``)."""
+    limit, measured = LONG_LOGS[name]
+    e = _relations_error(real_data, name)
+    assert e.trans_mean <= limit, f"{name}: {e.trans_mean:.4f} m (measured {measured} m)"
+
+
+@pytest.mark.xfail(strict=True, reason="0.358 m: the heading wanders 0-4 degrees off the "
+                   "reference's over the 1.9 km, and lengths come out 0.4 % short")  # fmt: skip
+def test_killian_meets_the_aim(real_data):
+    """MIT Killian Court within 0.15 m of its pseudo ground truth."""
+    e = _relations_error(real_data, "mit-killian-full")
+    assert e.trans_mean <= 0.15, f"{e.trans_mean:.4f} m"
+
+
 def test_the_hospitals_relations_under_a_minute_hold(real_data):
     """The hospital's mean over all relations is decided by its return to the start (closed
     by the global search, above); its 2,642 relations under a minute measure the local

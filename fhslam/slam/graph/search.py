@@ -55,16 +55,7 @@ class GlobalSearch:
         p = self.params
         h = self._hypothesis
         if h is not None and i - h[1] > p.search.keyframes + p.search.every:
-            # not confirmed in time: a last chance, the query just before its own
-            back = h[1] - p.search.keyframes
-            self._hypothesis = None
-            conf = min(p.search.min_score, p.search.confirm_score)
-            b = self._global_match(back, poses, conf) if back >= 0 else None
-            if b is not None and self._agree(
-                b, h, poses, (GLOBAL_CONSISTENCY, GLOBAL_CONSISTENCY_DEG)
-            ):
-                return self._close_pair(i, b, h, poses)
-            h = None
+            h = self._hypothesis = None  # not confirmed in time
         if h is None and i - self._last_global < p.search.every:
             return False
         if h is not None and i - h[1] < p.search.keyframes:
@@ -80,9 +71,6 @@ class GlobalSearch:
             if g[4] >= p.search.min_score:
                 self._hypothesis = g
             return False
-        return self._close_pair(i, h, g, poses)
-
-    def _close_pair(self, i, h, g, poses) -> bool:
         self._hypothesis = None
         closed = [self._add_loop(*x[:5]) for x in (h, g)]
         blind = self._path[i] - self._last_loop_path

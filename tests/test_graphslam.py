@@ -55,36 +55,6 @@ def test_closures_that_agree_are_added_without_optimising(three_laps, monkeypatc
     assert ate(lazy, truth).rmse <= ate(eager, truth).rmse + 0.002  # measured 0.42 vs 0.49 cm
 
 
-def test_a_closures_weight_falls_continuously_with_its_rms():
-    """No cut on a closure's rms that range noise could push the right match across: its
-    information falls smoothly (Tukey's biweight, scale ``LOOP_RMS_SCALE`` = 6 cm)."""
-    w = closure.rms_weight
-    assert w(0.0) == 1.0 and w(0.03) == pytest.approx(0.5625, abs=1e-12)
-    assert w(0.06) == 0.0 and w(0.2) == 0.0 and w(float("inf")) == 0.0
-    rms = np.linspace(0.0, 0.08, 801)
-    ws = np.array([w(r) for r in rms])
-    assert np.all(np.diff(ws) <= 0.0)  # never rises
-    assert np.abs(np.diff(ws)).max() <= 0.0031  # measured 0.0030 per 0.1 mm: no jump
-
-    from fhslam.scanmatch import Refinement
-
-    slam = GraphFastHoughSLAM()
-    poses = np.zeros((8, 3))
-    hessian = np.diag([4e4, 1e3, 2e3])
-
-    def verified(rms, n=400):
-        ref = Refinement(np.array([0.1, 0.0, 0.01]), hessian, n, rms)
-        return slam._verified(0, 7, ref, np.array([0.1, 0.0, 0.01]), 0.8, poses)
-
-    below, above = verified(0.0299), verified(0.0301)
-    assert below is not None and above is not None  # both enter the graph...
-    np.testing.assert_allclose(above[3], below[3], rtol=0.01)  # ...about alike: measured 0.9 %
-    full = slam._information(Refinement(np.zeros(3), hessian, 400, 0.0), 0.01)
-    np.testing.assert_allclose(below[3], w(0.0299) * full, rtol=1e-12)
-    assert verified(0.061) is None  # a loose fit has no weight, so no closure
-    assert verified(0.01, n=closure.LOOP_MIN_PAIRS - 1) is None  # too few pairs
-
-
 def test_a_closure_that_moves_its_keyframe_far_waits_for_an_independent_one():
     """Held closures agree when, carried along the graph to the same keyframe, they place
     it within 15 cm and 2° (``loops.consistency``, ``LOOP_CONSISTENCY_DEG``)."""

@@ -5,10 +5,8 @@ the ``loops.candidates`` old keyframes that looked nearest the same place (the m
 their clouds: driving a corridor back the other way, a 180° laser sees what keyframes a few
 metres *ahead* saw); the search radius and window grow with the travel since the last
 closure. A match enters the graph only with a fine score of at least ``loops.min_score`` and
-``LOOP_MIN_PAIRS`` points on a line, with a Cauchy kernel and its information weighted by how
-tightly those points lie (:func:`rms_weight`: no cut a little range noise could push the right
-match across); after each optimisation a closure whose error stays above ``loops.max_chi2`` is
-switched off.
+``LOOP_MIN_PAIRS`` points on a line within ``LOOP_MAX_RMS``, with a Cauchy kernel; after each
+optimisation a closure whose error stays above ``loops.max_chi2`` is switched off.
 
 A closure that would move its keyframe far (``loops.confirm_distance``), or whose match is not
 unique, is *held* until another agrees with it: one from a query and against a target that
@@ -31,15 +29,15 @@ from numpy.typing import NDArray
 from fhslam.geometry import compose, relative
 from fhslam.scanmatch import Refinement, match_clouds, refine, voxel_downsample
 
-__all__ = ["LoopClosing", "LoopClosure", "rms_weight"]
+__all__ = ["LoopClosing", "LoopClosure"]
 
 # Fixed by the method (measured; not parameters):
 LOOP_MAX_WINDOW = 3.0
 """The local search's window grows to at most this, ± metres."""
 LOOP_MIN_PAIRS = 50
 """A closure's refinement pairs at least this many query points with a line..."""
-LOOP_RMS_SCALE = 0.06
-"""... at an rms distance below this, metres: the scale of :func:`rms_weight`."""
+LOOP_MAX_RMS = 0.03
+"""... at an rms distance of at most this, metres."""
 LOOP_KERNEL = 3.0
 """Cauchy kernel scale of loop edges (Mahalanobis units): one at the 95 % bound of a
 three-dimensional χ² keeps more than half its weight."""
@@ -73,15 +71,6 @@ class LoopClosure:
     score: float
     edge: int = -1
     """Its edge in :attr:`GraphFastHoughSLAM.graph`."""
-
-
-def rms_weight(rms: float) -> float:
-    """The share of its information a closure whose refinement pairs its points with lines at
-    an rms distance of ``rms`` metres keeps: Tukey's biweight ``(1 - (rms / s)²)²`` with
-    ``s = LOOP_RMS_SCALE``, 1 for a perfect fit, 0.56 at half the scale, 0 from the scale on.
-    Continuous: range noise that moves a match's rms a little moves its weight a little."""
-    u = min(rms / LOOP_RMS_SCALE, 1.0)
-    return (1.0 - u * u) ** 2
 
 
 class HeldClosure(NamedTuple):
@@ -209,14 +198,12 @@ class LoopClosing:
     def _verified(self, j: int, i: int, ref: Refinement, matched, score: float, poses):
         """The closure ``(j, i, z, information, score, where it puts keyframe i)`` from a
         match of keyframe ``i``'s query against ``j``'s target at ``matched``, refined to
-        ``ref``, its information weighted by :func:`rms_weight`; None if the refinement pairs
-        too few points, or so loosely that the weight is 0. The refined pose is taken unless
-        it wandered more than 5 cm from the match."""
-        w = rms_weight(ref.rms) if ref.n_matched >= LOOP_MIN_PAIRS else 0.0
-        if w == 0.0:
+        ``ref``; None if the refinement pairs too few points or too loosely. The refined
+        pose is taken unless it wandered more than 5 cm from the match."""
+        if ref.n_matched < LOOP_MIN_PAIRS or ref.rms > LOOP_MAX_RMS:
             return None
         z = ref.pose if np.hypot(*(ref.pose[:2] - matched[:2])) <= 0.05 else matched
-        return j, i, z, w * self._information(ref, float(z[2])), score, compose(poses[j], z)
+        return j, i, z, self._information(ref, float(z[2])), score, compose(poses[j], z)
 
     def _add_loop(self, j: int, i: int, z, info, score: float) -> int:
         e = self._graph.add_edge(j, i, z, info, LOOP_KERNEL, kind="loop")

@@ -81,10 +81,14 @@ def test_a_long_log_meets_its_limit(real_data, name):
     assert e.trans_mean <= limit, f"{name}: {e.trans_mean:.4f} m (measured {measured} m)"
 
 
-@pytest.mark.xfail(strict=True, reason="0.358 m: the heading wanders 0-4 degrees off the "
-                   "reference's over the 1.9 km, and lengths come out 0.4 % short")  # fmt: skip
+@pytest.mark.xfail(strict=True, reason="0.358 m: 65 % of it from relations over 50 m, whose "
+                   "directions lie up to 1 degree off the reference's")  # fmt: skip
 def test_killian_meets_the_aim(real_data):
-    """MIT Killian Court within 0.15 m of its pseudo ground truth."""
+    """MIT Killian Court within 0.15 m of its pseudo ground truth (GMapping's poses, a floor
+    not known). Relations under 10 m are 0.05-0.07 m off; those over 50 m (14 % of them)
+    1.68 m, their directions -0.95 to +1.1 degrees off (10th-90th percentile). Lengths come
+    out 0.4 % short, but the best uniform scale explains only 0.012 m of the error, and the
+    odometry lengthened by its own 0.8 % shortfall 0.017 m."""
     e = _relations_error(real_data, "mit-killian-full")
     assert e.trans_mean <= 0.15, f"{e.trans_mean:.4f} m"
 

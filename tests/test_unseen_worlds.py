@@ -35,13 +35,28 @@ def test_the_default_slam_meets_the_limit_on_unseen_worlds_moved_noisy_and_dropp
     assert ate(run_slam(log).poses, log.truth).rmse <= LIMIT_M
 
 
-@pytest.mark.xfail(strict=True, reason="3.98 cm (the paper's procedure 3.20 cm): the 2 cm limit")
-def test_a_paper_world_log_nobody_picked_meets_the_limit():
-    """Seed 209544132 of the paper world at the ``medium`` odometry noise, one of the eight
-    the benchmark seeded 3209647287 drew (``fhslam benchmark --draw-seed 3209647287``; three
-    of them end over 2 cm: 2.11, 2.26 and this one's 3.98 cm, in every frame alike)."""
+PAPER_WORLD_MISSES = {
+    209544132: "3.98 cm (the paper's procedure 3.20 cm): the 2 cm limit",
+    147531616: "5.23 cm where the paper's procedure is at 1.99 cm: the 2 cm limit",
+}
+"""Paper-world seeds drawn by ``fhslam benchmark`` (209544132 with ``--draw-seed 3209647287``,
+147531616 with ``--draw-seed 1711281636``) on which the default misses the limit, in every
+frame alike."""
+
+
+@pytest.mark.parametrize(
+    "seed",
+    [
+        pytest.param(s, marks=pytest.mark.xfail(strict=True, reason=r))
+        for s, r in PAPER_WORLD_MISSES.items()
+    ],
+)
+def test_a_paper_world_log_nobody_picked_meets_the_limit(seed):
+    """A paper world at the ``medium`` odometry noise, drawn by the benchmark: the default
+    within 2 cm (of the eight seeds of draw seed 3209647287 three end over it: 2.11, 2.26 and
+    3.98 cm; of those of 1711281636, 147531616 at 5.23 cm)."""
     from fhslam.experiments.compare import one_run
 
-    (graph,) = one_run("paper", "medium", 209544132, ("graph",))
+    (graph,) = one_run("paper", "medium", seed, ("graph",))
     assert graph.odometry_ate_rmse > 1.0  # the odometry drifts metres
     assert graph.ate_rmse <= 0.02

@@ -35,12 +35,6 @@ in a row were doubtful, or the doubtful scans in a row span ``keyframes.distance
 odometry (new ground: a sparse log moves a metre between two scans)."""
 
 
-NORMAL_MIN_LENGTH = 0.4
-"""A keyframe point's normal comes from a window of beams at least this long (metres)..."""
-NORMAL_WIDE = 6
-"""... the ``2 × 6 + 1`` beams around it where the default seven span less."""
-
-
 def scan_cloud(points: NDArray[np.float64]) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """A scan's points (laser frame, beam order) as they enter a keyframe's cloud, with
     their normals (NaN: none): moved onto the line of their beam neighbours where the
@@ -49,14 +43,6 @@ def scan_cloud(points: NDArray[np.float64]) -> tuple[NDArray[np.float64], NDArra
     in between beams (:func:`fhslam.scanmatch.densify`), the points with a normal first (so
     that thinning to one point per voxel keeps them)."""
     normals = scan_normals(points)
-    if len(points) >= 2 * NORMAL_WIDE + 1:
-        # A normal's angle is off by about the range noise over the window's length: where
-        # seven beams span less than NORMAL_MIN_LENGTH (a wall close by), take a wider one.
-        wide = scan_normals(points, half_window=NORMAL_WIDE)
-        length = np.full(len(points), np.inf)
-        length[3:-3] = np.hypot(*(points[6:] - points[:-6]).T)
-        use = (length < NORMAL_MIN_LENGTH) & np.isfinite(wide[:, 0]) & np.isfinite(normals[:, 0])
-        normals = np.where(use[:, None], wide, normals)
     points = smooth_scan(points, normals)
     dense, dense_normals = densify(points, normals)
     first = np.argsort(np.isnan(dense_normals[:, 0]), kind="stable")

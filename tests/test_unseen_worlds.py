@@ -38,10 +38,12 @@ def test_the_default_slam_meets_the_limit_on_unseen_worlds_moved_noisy_and_dropp
 PAPER_WORLD_MISSES = {
     209544132: "3.98 cm (the paper's procedure 3.20 cm): the 2 cm limit",
     147531616: "5.23 cm where the paper's procedure is at 1.99 cm: the 2 cm limit",
+    1783398030: "3.60 cm (the paper's procedure 2.15 cm): the 2 cm limit",
 }
 """Paper-world seeds drawn by ``fhslam benchmark`` (209544132 with ``--draw-seed 3209647287``,
-147531616 with ``--draw-seed 1711281636``) on which the default misses the limit, in every
-frame alike."""
+147531616 and 1783398030 with ``--draw-seed 1711281636``) on which the default misses the
+limit by over a centimetre, in every frame alike; all three go wrong in the 2 m corridor
+(y 6-8 m) just after turning east into it."""
 
 
 @pytest.mark.parametrize(
@@ -54,7 +56,7 @@ frame alike."""
 def test_a_paper_world_log_nobody_picked_meets_the_limit(seed):
     """A paper world at the ``medium`` odometry noise, drawn by the benchmark: the default
     within 2 cm (of the eight seeds of draw seed 3209647287 three end over it: 2.11, 2.26 and
-    3.98 cm; of those of 1711281636, 147531616 at 5.23 cm)."""
+    3.98 cm; of those of 1711281636 two: 3.60 and 5.23 cm)."""
     from fhslam.experiments.compare import one_run
 
     (graph,) = one_run("paper", "medium", seed, ("graph",))
